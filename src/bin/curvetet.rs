@@ -1,0 +1,3 @@
+fn main() {
+    println!("curvetet {}", env!("CARGO_PKG_VERSION"));
+}

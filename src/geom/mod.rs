@@ -1,0 +1,7 @@
+//! Pure geometry, no topology: exact predicates, P2 shape functions, quadrature,
+//! Bernstein (Bézier) bounds of the P2 tetrahedron's Jacobian, and quality metrics.
+
+pub mod predicates;
+pub mod vec3;
+
+pub use vec3::P3;

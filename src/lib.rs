@@ -1,0 +1,16 @@
+//! curvetet: direct quadratic (10-node) curvilinear tetrahedral meshing of closed quadratic
+//! (6-node) triangle surfaces by an advancing front, with certified element validity.
+//!
+//! Data flows one way: [`io`] reads a [`Surface`] (checked on construction), the front
+//! fills it with straight-sided P2 tetrahedra, the optimizer moves the free high-order
+//! nodes, and the result is certified (Bernstein bounds of the Jacobian) before it is
+//! returned as a [`TetMesh`].
+
+pub mod error;
+pub mod geom;
+pub mod mesh;
+pub mod surface;
+
+pub use error::{Error, Result, SurfaceDefect};
+pub use mesh::TetMesh;
+pub use surface::Surface;

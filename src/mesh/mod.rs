@@ -1,0 +1,21 @@
+//! The output: a quadratic (10-node) tetrahedral mesh with its boundary.
+
+use crate::geom::P3;
+
+/// A P2 tetrahedral mesh.
+///
+/// Tets use Gmsh's 10-node order: corners 0..3, then mid nodes of edges (0,1), (1,2),
+/// (2,0), (3,0), (3,2), (3,1). Tets are positive (det[v1-v0, v2-v0, v3-v0] > 0).
+/// `boundary` holds the input triangles (same six node coordinates, outward) with their
+/// input `boundary_tags`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TetMesh {
+    /// All nodes: the input surface's nodes first (same indices), then interior ones.
+    pub nodes: Vec<P3>,
+    /// 10-node tetrahedra, Gmsh order.
+    pub tets: Vec<[u32; 10]>,
+    /// 6-node boundary triangles, Gmsh order, outward.
+    pub boundary: Vec<[u32; 6]>,
+    /// One tag per boundary triangle.
+    pub boundary_tags: Vec<i32>,
+}
