@@ -123,17 +123,26 @@ pub enum Error {
 impl Error {
     /// Shorthand for a surface defect error.
     pub fn surface(kind: SurfaceDefect, msg: impl Into<String>) -> Error {
-        Error::InvalidSurface { kind, msg: msg.into() }
+        Error::InvalidSurface {
+            kind,
+            msg: msg.into(),
+        }
     }
 
     /// Shorthand for a parse error.
     pub fn parse(location: impl Into<String>, msg: impl Into<String>) -> Error {
-        Error::Parse { location: location.into(), msg: msg.into() }
+        Error::Parse {
+            location: location.into(),
+            msg: msg.into(),
+        }
     }
 
     /// Shorthand for an I/O error on a path.
     pub fn io(path: impl AsRef<std::path::Path>, source: std::io::Error) -> Error {
-        Error::Io { path: path.as_ref().display().to_string(), source }
+        Error::Io {
+            path: path.as_ref().display().to_string(),
+            source,
+        }
     }
 
     /// The surface defect kind, if this is a surface error.

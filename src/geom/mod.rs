@@ -2,6 +2,7 @@
 //! Bernstein (Bézier) bounds of the P2 tetrahedron's Jacobian, and quality metrics.
 
 pub mod predicates;
+pub mod shape;
 pub mod vec3;
 
 pub use vec3::P3;

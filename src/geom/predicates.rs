@@ -30,7 +30,11 @@ pub fn orient3d(a: P3, b: P3, c: P3, d: P3) -> i32 {
 
 #[inline]
 fn c3(p: P3) -> Coord3D<f64> {
-    Coord3D { x: p[0], y: p[1], z: p[2] }
+    Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
 }
 
 /// A projection of a plane onto two coordinate axes.
@@ -43,7 +47,10 @@ pub struct Proj {
 impl Proj {
     #[inline]
     fn p(self, a: P3) -> Coord<f64> {
-        Coord { x: a[self.i], y: a[self.j] }
+        Coord {
+            x: a[self.i],
+            y: a[self.j],
+        }
     }
     /// Sign of the 2D orientation of (a, b, c) in this projection. Exact.
     #[inline]
@@ -224,7 +231,11 @@ mod tests {
         let mut naive_wrong = 0;
         for k in 0..2000 {
             let t = (k as f64) * 1e-3;
-            let d = [a[0] + t * (c[0] - a[0]), a[1] + t * (c[1] - a[1]), a[2] + t * (c[2] - a[2])];
+            let d = [
+                a[0] + t * (c[0] - a[0]),
+                a[1] + t * (c[1] - a[1]),
+                a[2] + t * (c[2] - a[2]),
+            ];
             let s = orient3d(a, b, c, d);
             let naive = crate::geom::vec3::tet_det(a, b, c, d);
             // Exact sign is antisymmetric under swapping two points: a cheap self-check.
@@ -253,7 +264,11 @@ mod tests {
         let w = [0.0, 0.0, 1.0];
         for i in 0..64 {
             for j in 0..64 {
-                let pp = [p[0] + i as f64 * f64::EPSILON, p[1] + j as f64 * f64::EPSILON, 0.0];
+                let pp = [
+                    p[0] + i as f64 * f64::EPSILON,
+                    p[1] + j as f64 * f64::EPSILON,
+                    0.0,
+                ];
                 let s = orient3d(pp, q, r, w);
                 assert_eq!(s, orient3d(q, r, pp, w));
                 assert_eq!(s, -orient3d(q, pp, r, w));
@@ -279,27 +294,77 @@ mod tests {
         let t = [O, X, Y];
         let tid = [0, 1, 2];
         // Crossing through the interior.
-        assert!(segment_triangle_conflict([[0.2, 0.2, -1.0], [0.2, 0.2, 1.0]], [10, 11], t, tid));
+        assert!(segment_triangle_conflict(
+            [[0.2, 0.2, -1.0], [0.2, 0.2, 1.0]],
+            [10, 11],
+            t,
+            tid
+        ));
         // Missing.
-        assert!(!segment_triangle_conflict([[0.8, 0.8, -1.0], [0.8, 0.8, 1.0]], [10, 11], t, tid));
+        assert!(!segment_triangle_conflict(
+            [[0.8, 0.8, -1.0], [0.8, 0.8, 1.0]],
+            [10, 11],
+            t,
+            tid
+        ));
         // Touching an edge: a conflict (no shared vertex).
-        assert!(segment_triangle_conflict([[0.5, 0.5, -1.0], [0.5, 0.5, 1.0]], [10, 11], t, tid));
+        assert!(segment_triangle_conflict(
+            [[0.5, 0.5, -1.0], [0.5, 0.5, 1.0]],
+            [10, 11],
+            t,
+            tid
+        ));
         // Shared vertex, not coplanar: fine.
-        assert!(!segment_triangle_conflict([O, [0.2, 0.2, 1.0]], [0, 11], t, tid));
+        assert!(!segment_triangle_conflict(
+            [O, [0.2, 0.2, 1.0]],
+            [0, 11],
+            t,
+            tid
+        ));
         // Shared vertex, coplanar, inside the angle: conflict.
-        assert!(segment_triangle_conflict([O, [0.2, 0.2, 0.0]], [0, 11], t, tid));
+        assert!(segment_triangle_conflict(
+            [O, [0.2, 0.2, 0.0]],
+            [0, 11],
+            t,
+            tid
+        ));
         // Shared vertex, coplanar, outside the angle: fine.
-        assert!(!segment_triangle_conflict([O, [-0.2, 0.2, 0.0]], [0, 11], t, tid));
+        assert!(!segment_triangle_conflict(
+            [O, [-0.2, 0.2, 0.0]],
+            [0, 11],
+            t,
+            tid
+        ));
         // Shared vertex, collinear overlap with an edge: conflict.
-        assert!(segment_triangle_conflict([O, [2.0, 0.0, 0.0]], [0, 11], t, tid));
+        assert!(segment_triangle_conflict(
+            [O, [2.0, 0.0, 0.0]],
+            [0, 11],
+            t,
+            tid
+        ));
         // An edge of the triangle: fine.
         assert!(!segment_triangle_conflict([O, X], [0, 1], t, tid));
         // Coplanar, disjoint ids, crossing the triangle: conflict.
-        assert!(segment_triangle_conflict([[-1.0, 0.3, 0.0], [2.0, 0.3, 0.0]], [10, 11], t, tid));
+        assert!(segment_triangle_conflict(
+            [[-1.0, 0.3, 0.0], [2.0, 0.3, 0.0]],
+            [10, 11],
+            t,
+            tid
+        ));
         // Coplanar, disjoint: fine.
-        assert!(!segment_triangle_conflict([[-1.0, 3.0, 0.0], [2.0, 3.0, 0.0]], [10, 11], t, tid));
+        assert!(!segment_triangle_conflict(
+            [[-1.0, 3.0, 0.0], [2.0, 3.0, 0.0]],
+            [10, 11],
+            t,
+            tid
+        ));
         // Endpoint touching the interior from above: conflict.
-        assert!(segment_triangle_conflict([[0.2, 0.2, 0.0], [0.2, 0.2, 1.0]], [10, 11], t, tid));
+        assert!(segment_triangle_conflict(
+            [[0.2, 0.2, 0.0], [0.2, 0.2, 1.0]],
+            [10, 11],
+            t,
+            tid
+        ));
     }
 
     #[test]
@@ -311,10 +376,25 @@ mod tests {
         // One ulp beside the edge x + y = 1 (at x = 0.5): outside, then inside.
         let up = f64::from_bits(0.5f64.to_bits() + 1);
         let down = f64::from_bits(0.5f64.to_bits() - 1);
-        assert!(!segment_triangle_conflict([[up, 0.5, -1.0], [up, 0.5, 1.0]], [7, 8], t, tid));
-        assert!(segment_triangle_conflict([[down, 0.5, -1.0], [down, 0.5, 1.0]], [7, 8], t, tid));
+        assert!(!segment_triangle_conflict(
+            [[up, 0.5, -1.0], [up, 0.5, 1.0]],
+            [7, 8],
+            t,
+            tid
+        ));
+        assert!(segment_triangle_conflict(
+            [[down, 0.5, -1.0], [down, 0.5, 1.0]],
+            [7, 8],
+            t,
+            tid
+        ));
         // On the edge exactly: touching counts.
-        assert!(segment_triangle_conflict([[0.5, 0.5, -1.0], [0.5, 0.5, 1.0]], [7, 8], t, tid));
+        assert!(segment_triangle_conflict(
+            [[0.5, 0.5, -1.0], [0.5, 0.5, 1.0]],
+            [7, 8],
+            t,
+            tid
+        ));
     }
 
     #[test]
@@ -322,11 +402,26 @@ mod tests {
         let a = [O, X, Y];
         let aid = [0, 1, 2];
         // Shares edge (O, X), folded up: fine.
-        assert!(!triangle_triangle_conflict(a, aid, [O, X, [0.3, 0.0, 1.0]], [0, 1, 3]));
+        assert!(!triangle_triangle_conflict(
+            a,
+            aid,
+            [O, X, [0.3, 0.0, 1.0]],
+            [0, 1, 3]
+        ));
         // Shares edge, coplanar on the same side: overlap.
-        assert!(triangle_triangle_conflict(a, aid, [X, O, [0.3, 0.4, 0.0]], [1, 0, 3]));
+        assert!(triangle_triangle_conflict(
+            a,
+            aid,
+            [X, O, [0.3, 0.4, 0.0]],
+            [1, 0, 3]
+        ));
         // Shares edge, coplanar on the other side: fine.
-        assert!(!triangle_triangle_conflict(a, aid, [X, O, [0.3, -0.4, 0.0]], [1, 0, 3]));
+        assert!(!triangle_triangle_conflict(
+            a,
+            aid,
+            [X, O, [0.3, -0.4, 0.0]],
+            [1, 0, 3]
+        ));
         // Piercing without shared vertices.
         assert!(triangle_triangle_conflict(
             a,
@@ -342,7 +437,12 @@ mod tests {
             [5, 6, 7]
         ));
         // Shares one vertex, the other triangle cuts through a's interior along a line from O.
-        assert!(triangle_triangle_conflict(a, aid, [O, [0.5, 0.5, -1.0], [0.5, 0.5, 1.0]], [0, 5, 6]));
+        assert!(triangle_triangle_conflict(
+            a,
+            aid,
+            [O, [0.5, 0.5, -1.0], [0.5, 0.5, 1.0]],
+            [0, 5, 6]
+        ));
         // Coplanar, one inside the other, no shared ids.
         assert!(triangle_triangle_conflict(
             a,

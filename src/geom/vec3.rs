@@ -35,7 +35,11 @@ pub fn dot(a: P3, b: P3) -> f64 {
 /// a x b
 #[inline]
 pub fn cross(a: P3, b: P3) -> P3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 /// |a|
 #[inline]
@@ -60,7 +64,11 @@ pub fn dist2(a: P3, b: P3) -> f64 {
 /// (a + b) / 2
 #[inline]
 pub fn mid(a: P3, b: P3) -> P3 {
-    [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])]
+    [
+        0.5 * (a[0] + b[0]),
+        0.5 * (a[1] + b[1]),
+        0.5 * (a[2] + b[2]),
+    ]
 }
 /// a / |a| (returns a unchanged when |a| == 0)
 #[inline]
@@ -91,5 +99,9 @@ pub fn tri_normal(a: P3, b: P3, c: P3) -> P3 {
 #[inline]
 pub fn centroid3(a: P3, b: P3, c: P3) -> P3 {
     let t = 1.0 / 3.0;
-    [(a[0] + b[0] + c[0]) * t, (a[1] + b[1] + c[1]) * t, (a[2] + b[2] + c[2]) * t]
+    [
+        (a[0] + b[0] + c[0]) * t,
+        (a[1] + b[1] + c[1]) * t,
+        (a[2] + b[2] + c[2]) * t,
+    ]
 }
