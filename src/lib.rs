@@ -7,10 +7,13 @@
 //! returned as a [`TetMesh`].
 
 pub mod error;
+pub mod front;
 pub mod geom;
 pub mod mesh;
+pub mod options;
 pub mod surface;
 
 pub use error::{Error, Result, SurfaceDefect};
 pub use mesh::TetMesh;
+pub use options::{Options, SizeMode};
 pub use surface::Surface;

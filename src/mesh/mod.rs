@@ -19,3 +19,6 @@ pub struct TetMesh {
     /// One tag per boundary triangle.
     pub boundary_tags: Vec<i32>,
 }
+
+pub mod build;
+pub mod check;

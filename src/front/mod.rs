@@ -1,0 +1,659 @@
+//! The advancing front (paper 2.1-2.8, Algorithms 1 and 2), with a closing strategy that
+//! goes beyond the paper: relaxed filters in steps, then local remeshing.
+//!
+//! The front starts as the input triangles turned inward. Each step takes the smallest
+//! live front face, places the ideal apex at the regular-tetrahedron height along its
+//! inward normal, gathers front vertices within `alpha * h` of it, ranks candidates by
+//! quality (Algorithm 2: an existing vertex near the ideal point beats a new one), and
+//! accepts the first that passes the exact validity test and, when it touches the
+//! curved boundary, the certified Jacobian test. New faces that coincide with front
+//! faces close them.
+
+mod grid;
+mod repair;
+pub mod size;
+mod tmp_quality;
+pub mod validity;
+
+use crate::geom::predicates::orient3d;
+use crate::geom::shape::{tet10_det_jacobian, tri6_normal, TET10_EDGES};
+use crate::geom::vec3::*;
+use crate::options::Options;
+use crate::{Error, Result};
+use grid::{Aabb, FaceGrid};
+use kiddo::{MutableKdTree, SquaredEuclidean};
+use size::{regular_height, SizeField};
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap};
+use validity::{FaceRef, TET_OUT_FACES};
+
+/// What the front produced: straight-sided tets on low-order vertices.
+pub struct FrontOutput {
+    /// All points: the surface nodes (same indices) then the new interior vertices.
+    pub pts: Vec<P3>,
+    /// Positive tets (corner ids).
+    pub tets: Vec<[u32; 4]>,
+    /// Statistics of the run.
+    pub stats: FrontStats,
+}
+
+/// Counters of one front run.
+#[derive(Debug, Default, Clone, serde::Serialize)]
+pub struct FrontStats {
+    /// Faces processed (pops of the queue that were live).
+    pub steps: u64,
+    /// Tets accepted at relaxed levels 1 and 2.
+    pub relaxed: [u64; 2],
+    /// Tets accepted with a new vertex.
+    pub new_vertices: u64,
+    /// Local remeshing operations.
+    pub repairs: u64,
+    /// Tets deleted by repairs.
+    pub deleted: u64,
+}
+
+#[derive(Clone, Copy)]
+struct Face {
+    v: [u32; 3],
+    alive: bool,
+    tries: u8,
+    /// Index of the input triangle when this face is a boundary face, else u32::MAX.
+    btri: u32,
+}
+
+/// Ordered f64 for the queue.
+#[derive(Clone, Copy, PartialEq, PartialOrd)]
+struct Key(f64);
+impl Eq for Key {}
+#[allow(clippy::derive_ord_xor_partial_ord)]
+impl Ord for Key {
+    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&o.0)
+    }
+}
+
+/// A candidate apex.
+#[derive(Clone, Copy)]
+struct Cand {
+    id: u32, // u32::MAX for a new point
+    p: P3,
+    q: f64,
+    dist_a: f64,
+}
+
+const NEW: u32 = u32::MAX;
+thread_local! { pub static FAILS: std::cell::RefCell<[[u64;4];3]> = const { std::cell::RefCell::new([[0;4];3]) }; }
+
+#[inline]
+fn key3(v: [u32; 3]) -> [u32; 3] {
+    let mut k = v;
+    k.sort_unstable();
+    k
+}
+
+/// Progress callback: fraction in [0, 1], stage name; returns true to cancel.
+pub type Progress<'p> = &'p mut dyn FnMut(f64, &str) -> bool;
+
+pub(crate) struct Mesher<'a> {
+    opts: &'a Options,
+    surf_nodes: &'a [P3],
+    surf_tris: &'a [[u32; 6]],
+    n_surf: usize,
+    pts: Vec<P3>,
+    vdeg: Vec<u32>,
+    in_tree: Vec<bool>,
+    faces: Vec<Face>,
+    face_map: HashMap<[u32; 3], u32>,
+    btri_map: HashMap<[u32; 3], u32>,
+    bedge_mid: HashMap<(u32, u32), u32>,
+    heap: BinaryHeap<Reverse<(u8, Key, u32)>>,
+    grid: FaceGrid,
+    vtree: MutableKdTree<f64, 3>,
+    tets: Vec<[u32; 4]>,
+    tet_alive: Vec<bool>,
+    size: SizeField,
+    stats: FrontStats,
+    repairs_at: HashMap<(i32, i32, i32), u32>,
+    repair_cell: f64,
+    // scratch
+    near_ids: Vec<u32>,
+    near: Vec<FaceRef>,
+    cands: Vec<Cand>,
+    volume_done: f64,
+}
+
+impl<'a> Mesher<'a> {
+    pub(crate) fn new(
+        surf_nodes: &'a [P3],
+        surf_tris: &'a [[u32; 6]],
+        opts: &'a Options,
+        size: SizeField,
+    ) -> Mesher<'a> {
+        let n_surf = surf_nodes.len();
+        let mut edge_len_sum = 0.0;
+        let mut edge_len_max = 0.0f64;
+        let mut bedge_mid = HashMap::with_capacity(surf_tris.len() * 3 / 2);
+        for t in surf_tris {
+            for (k, [i, j]) in crate::geom::shape::TRI6_EDGES.iter().enumerate() {
+                let (a, b) = (t[*i], t[*j]);
+                let l = dist(surf_nodes[a as usize], surf_nodes[b as usize]);
+                edge_len_sum += l;
+                edge_len_max = edge_len_max.max(l);
+                bedge_mid.insert((a.min(b), a.max(b)), t[3 + k]);
+            }
+        }
+        let mean_edge = edge_len_sum / (3 * surf_tris.len()).max(1) as f64;
+        let lo = Aabb::of(surf_nodes).lo;
+        let cell = mean_edge.max(edge_len_max / 8.0);
+        let mut m = Mesher {
+            opts,
+            surf_nodes,
+            surf_tris,
+            n_surf,
+            pts: surf_nodes.to_vec(),
+            vdeg: vec![0; n_surf],
+            in_tree: vec![false; n_surf],
+            faces: Vec::with_capacity(surf_tris.len() * 4),
+            face_map: HashMap::with_capacity(surf_tris.len() * 2),
+            btri_map: HashMap::with_capacity(surf_tris.len()),
+            bedge_mid,
+            heap: BinaryHeap::new(),
+            grid: FaceGrid::new(lo, cell),
+            vtree: MutableKdTree::default(),
+            tets: Vec::new(),
+            tet_alive: Vec::new(),
+            size,
+            stats: FrontStats::default(),
+            repairs_at: HashMap::new(),
+            repair_cell: 2.0 * mean_edge,
+            near_ids: Vec::new(),
+            near: Vec::new(),
+            cands: Vec::new(),
+            volume_done: 0.0,
+        };
+        for (i, t) in surf_tris.iter().enumerate() {
+            m.btri_map.insert(key3([t[0], t[1], t[2]]), i as u32);
+            // Front faces point into the unmeshed region: reverse the outward input.
+            m.add_face([t[0], t[2], t[1]]);
+        }
+        m
+    }
+
+    fn add_face(&mut self, v: [u32; 3]) {
+        let id = self.faces.len() as u32;
+        let k = key3(v);
+        let btri = if v.iter().all(|&x| (x as usize) < self.n_surf) {
+            self.btri_map.get(&k).copied().unwrap_or(u32::MAX)
+        } else {
+            u32::MAX
+        };
+        self.faces.push(Face {
+            v,
+            alive: true,
+            tries: 0,
+            btri,
+        });
+        self.face_map.insert(k, id);
+        let p = [
+            self.pts[v[0] as usize],
+            self.pts[v[1] as usize],
+            self.pts[v[2] as usize],
+        ];
+        self.grid.insert(id, &Aabb::of(&p));
+        for &x in &v {
+            let xi = x as usize;
+            self.vdeg[xi] += 1;
+            if !self.in_tree[xi] {
+                self.in_tree[xi] = true;
+                let _ = self.vtree.add(&self.pts[xi], x);
+            }
+        }
+        let key = face_size(&p);
+        self.heap.push(Reverse((0, Key(key), id)));
+    }
+
+    fn kill_face(&mut self, id: u32) {
+        let f = &mut self.faces[id as usize];
+        if !f.alive {
+            return;
+        }
+        f.alive = false;
+        let v = f.v;
+        self.face_map.remove(&key3(v));
+        for &x in &v {
+            let xi = x as usize;
+            self.vdeg[xi] -= 1;
+            if self.vdeg[xi] == 0 && self.in_tree[xi] {
+                self.in_tree[xi] = false;
+                self.vtree.remove(&self.pts[xi], x);
+            }
+        }
+    }
+
+    fn new_point(&mut self, p: P3) -> u32 {
+        let id = self.pts.len() as u32;
+        self.pts.push(p);
+        self.vdeg.push(0);
+        self.in_tree.push(false);
+        id
+    }
+
+    /// The six nodes of boundary triangle `b` (input orientation).
+    fn btri_nodes(&self, b: u32) -> [P3; 6] {
+        let t = &self.surf_tris[b as usize];
+        std::array::from_fn(|k| self.surf_nodes[t[k] as usize])
+    }
+
+    /// Ten nodes of the P2 tet on corners `t`, with boundary mid nodes on boundary edges;
+    /// `None` when every edge is straight.
+    fn p2_nodes(&self, t: [u32; 4], tp: &[P3; 4]) -> Option<[P3; 10]> {
+        let mut x = [[0.0; 3]; 10];
+        x[..4].copy_from_slice(tp);
+        let mut curved = false;
+        for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
+            let (a, b) = (t[*i], t[*j]);
+            x[4 + k] = mid(tp[*i], tp[*j]);
+            if (a as usize) < self.n_surf && (b as usize) < self.n_surf {
+                if let Some(&m) = self.bedge_mid.get(&(a.min(b), a.max(b))) {
+                    let mp = self.surf_nodes[m as usize];
+                    if mp != x[4 + k] {
+                        x[4 + k] = mp;
+                        curved = true;
+                    }
+                }
+            }
+        }
+        curved.then_some(x)
+    }
+
+    fn run(&mut self, progress: Progress) -> Result<()> {
+        let total_volume = {
+            let mut v = 0.0;
+            for t in self.surf_tris {
+                let p = |k: usize| self.surf_nodes[t[k] as usize];
+                v += det3(p(0), p(1), p(2)) / 6.0;
+            }
+            v.abs().max(f64::MIN_POSITIVE)
+        };
+        let max_steps = 200 * self.surf_tris.len() as u64 + 1_000_000;
+        let max_repairs = 50 + self.surf_tris.len() as u64;
+        let mut last_report = 0.0;
+        while let Some(Reverse((tries, _, fid))) = self.heap.pop() {
+            let f = self.faces[fid as usize];
+            if !f.alive || f.tries != tries {
+                continue;
+            }
+            self.stats.steps += 1;
+            if self.stats.steps % 20000 == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
+                let open = self.faces.iter().filter(|f| f.alive).count();
+                eprintln!("fails {:?}", FAILS.with(|f| *f.borrow()));
+                eprintln!(
+                    "step {} tets {} pts {} open {} tries {} stats {:?} vol {:.4}",
+                    self.stats.steps,
+                    self.tets.len(),
+                    self.pts.len(),
+                    open,
+                    tries,
+                    self.stats,
+                    self.volume_done
+                );
+            }
+            if self.stats.steps > max_steps {
+                return Err(self.stuck_error(fid, "step limit reached"));
+            }
+            let frac = (self.volume_done / total_volume).clamp(0.0, 1.0);
+            if frac - last_report >= 0.01 || self.stats.steps % 4096 == 0 {
+                last_report = frac;
+                if progress(frac, "front") {
+                    return Err(Error::Cancelled);
+                }
+            }
+            let max_level = tries.min(2);
+            let mut done = false;
+            for level in 0..=max_level {
+                if self.advance(fid, level) {
+                    if level > 0 {
+                        self.stats.relaxed[level as usize - 1] += 1;
+                    }
+                    done = true;
+                    break;
+                }
+            }
+            if done {
+                continue;
+            }
+            if tries < 3 {
+                self.faces[fid as usize].tries = tries + 1;
+                let p = self.face_pts(fid);
+                self.heap
+                    .push(Reverse((tries + 1, Key(face_size(&p)), fid)));
+                continue;
+            }
+            // Stuck at every level: remesh around it.
+            if self.stats.repairs >= max_repairs {
+                return Err(self.stuck_error(fid, "repair limit reached"));
+            }
+            self.repair(fid)?;
+        }
+        Ok(())
+    }
+
+    fn face_pts(&self, fid: u32) -> [P3; 3] {
+        let v = self.faces[fid as usize].v;
+        [
+            self.pts[v[0] as usize],
+            self.pts[v[1] as usize],
+            self.pts[v[2] as usize],
+        ]
+    }
+
+    fn stuck_error(&self, fid: u32, why: &str) -> Error {
+        let v = self.faces[fid as usize].v;
+        let c = {
+            let p = self.face_pts(fid);
+            centroid3(p[0], p[1], p[2])
+        };
+        let open = self.faces.iter().filter(|f| f.alive).count();
+        Error::MeshingFailed {
+            msg: format!(
+                "{why}: the front could not be closed near ({:.6}, {:.6}, {:.6}) at face with vertices {:?}; {open} front faces remain open",
+                c[0], c[1], c[2], v
+            ),
+            partial: None,
+        }
+    }
+
+    /// Try to build a tet on front face `fid` at relaxation `level`. True on success.
+    fn advance(&mut self, fid: u32, level: u8) -> bool {
+        let f = self.faces[fid as usize];
+        let fp = self.face_pts(fid);
+        let c = centroid3(fp[0], fp[1], fp[2]);
+        let flat_n = tri_normal(fp[0], fp[1], fp[2]);
+        let n = if f.btri != u32::MAX {
+            // Tangent-plane normal of the curved face at its centre (outward input: negate).
+            let x = self.btri_nodes(f.btri);
+            let nn = normalize(scale(tri6_normal(&x, 1.0 / 3.0, 1.0 / 3.0), -1.0));
+            if dot(nn, flat_n) > 0.0 {
+                nn
+            } else {
+                normalize(flat_n)
+            }
+        } else {
+            normalize(flat_n)
+        };
+        let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
+        let target = self.size.at(c).clamp(0.55 * lf, 1.8 * lf);
+        let h = regular_height(target);
+        let a = axpy(c, h, n);
+        let (radius, min_new_dist) = match level {
+            0 => (self.opts.alpha * h, 0.45 * target),
+            1 => (2.0 * self.opts.alpha * h, 0.25 * target),
+            _ => (3.0 * self.opts.alpha * h, 0.0),
+        };
+        // Candidate existing vertices.
+        let found = self
+            .vtree
+            .query(&a)
+            .within::<SquaredEuclidean<f64>>(radius * radius)
+            .unsorted()
+            .execute();
+        self.cands.clear();
+        let mut nearest_existing = f64::INFINITY;
+        for r in &found {
+            let id = r.item;
+            if f.v.contains(&id) {
+                continue;
+            }
+            let p = self.pts[id as usize];
+            nearest_existing = nearest_existing.min(r.distance.sqrt());
+            if orient3d(fp[0], fp[1], fp[2], p) <= 0 {
+                continue;
+            }
+            self.cands.push(Cand {
+                id,
+                p,
+                q: 0.0,
+                dist_a: r.distance.sqrt(),
+            });
+        }
+        // New points: the ideal one, and lower ones when relaxing.
+        let heights: &[f64] = match level {
+            0 => &[1.0],
+            1 => &[1.0, 0.6, 0.35],
+            _ => &[1.0, 0.6, 0.35, 0.2],
+        };
+        for &s in heights {
+            let p = axpy(c, s * h, n);
+            // Distance to existing front vertices near the new point.
+            let dmin = if s == 1.0 {
+                nearest_existing
+            } else {
+                self.nearest_front_vertex(p, target)
+            };
+            if dmin >= min_new_dist {
+                self.cands.push(Cand {
+                    id: NEW,
+                    p,
+                    q: 0.0,
+                    dist_a: 0.0,
+                });
+            }
+        }
+        if self.cands.is_empty() {
+            return false;
+        }
+        // Quality of each candidate (cheap, floating point).
+        let (min_dih, max_skew, min_gap) = match level {
+            0 => (
+                self.opts.min_dihedral_deg,
+                self.opts.max_skewness,
+                self.opts.min_edge_face_angle_deg,
+            ),
+            1 => (
+                self.opts.min_dihedral_deg / 3.0,
+                0.97,
+                self.opts.min_edge_face_angle_deg / 2.5,
+            ),
+            _ => (0.0, 1.0, 0.0),
+        };
+        let mut cands = std::mem::take(&mut self.cands);
+        cands.retain_mut(|cd| {
+            let tp = [fp[0], fp[1], fp[2], cd.p];
+            let ang = tmp_quality::dihedral_angles(&tp);
+            let mn = ang.iter().cloned().fold(f64::MAX, f64::min);
+            let sk = tmp_quality::skewness(&ang);
+            cd.q = 1.0 - sk;
+            mn >= min_dih && sk <= max_skew
+        });
+        // Order (Algorithm 2): best quality first; if the best is a new point, existing
+        // vertices closer than h to the ideal point come first, nearest first.
+        cands.sort_by(|x, y| y.q.total_cmp(&x.q).then(x.id.cmp(&y.id)));
+        if let Some(first) = cands.first() {
+            if first.id == NEW {
+                let mut close: Vec<Cand> = cands
+                    .iter()
+                    .filter(|c| c.id != NEW && c.dist_a < h)
+                    .cloned()
+                    .collect();
+                if !close.is_empty() {
+                    close.sort_by(|x, y| x.dist_a.total_cmp(&y.dist_a).then(x.id.cmp(&y.id)));
+                    let rest: Vec<Cand> = cands
+                        .iter()
+                        .filter(|c| c.id == NEW || c.dist_a >= h)
+                        .cloned()
+                        .collect();
+                    close.extend(rest);
+                    cands = close;
+                }
+            }
+        }
+        // Nearby front faces for the validity tests: everything that can touch any candidate.
+        let mut bb = Aabb::of(&fp);
+        for cd in &cands {
+            for d in 0..3 {
+                bb.lo[d] = bb.lo[d].min(cd.p[d]);
+                bb.hi[d] = bb.hi[d].max(cd.p[d]);
+            }
+        }
+        let faces = &self.faces;
+        let mut near_ids = std::mem::take(&mut self.near_ids);
+        self.grid
+            .query(&bb, |i| faces[i as usize].alive, &mut near_ids);
+        self.near.clear();
+        for &i in &near_ids {
+            if i != fid {
+                self.near.push(FaceRef {
+                    v: self.faces[i as usize].v,
+                });
+            }
+        }
+        self.near_ids = near_ids;
+        let mut chosen = None;
+        if cands.is_empty() {
+            FAILS.with(|f| f.borrow_mut()[level as usize][0] += 1);
+        }
+        for cd in &cands {
+            let apex = if cd.id == NEW { u32::MAX - 1 } else { cd.id };
+            let t = [f.v[0], f.v[1], f.v[2], apex];
+            let tp = [fp[0], fp[1], fp[2], cd.p];
+            let pts = &self.pts;
+            let pos = |i: u32| pts[i as usize];
+            let Some(verdict) = validity::check(t, tp, &self.near, pos) else {
+                FAILS.with(|f| f.borrow_mut()[level as usize][1] += 1);
+                continue;
+            };
+            if verdict.min_gap_deg < min_gap {
+                FAILS.with(|f| f.borrow_mut()[level as usize][2] += 1);
+                continue;
+            }
+            if let Some(x) = self.p2_nodes(t, &tp) {
+                if !curved_valid(&x) {
+                    FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
+                    continue;
+                }
+            }
+            chosen = Some(*cd);
+            break;
+        }
+        if chosen.is_none() && level == 2 && std::env::var_os("CURVETET_DEBUG2").is_some() {
+            let mut why = Vec::new();
+            for cd in &cands {
+                let apex = if cd.id == NEW { u32::MAX - 1 } else { cd.id };
+                let t = [f.v[0], f.v[1], f.v[2], apex];
+                let tp = [fp[0], fp[1], fp[2], cd.p];
+                let pts = &self.pts;
+                let v = validity::check(t, tp, &self.near, |i: u32| pts[i as usize]);
+                let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
+                let w = validity::WHY.with(|w| w.borrow().clone());
+                why.push(format!(
+                    "{}:{}:{:?}:{}",
+                    if cd.id == NEW { -1 } else { cd.id as i64 },
+                    v.is_some(),
+                    cur,
+                    w
+                ));
+            }
+            eprintln!(
+                "stuck face {} {:?} btri {} found {} cands {} near {}: {}",
+                fid,
+                f.v,
+                f.btri,
+                found.len(),
+                cands.len(),
+                self.near.len(),
+                why.join(" ")
+            );
+        }
+        self.cands = cands;
+        let Some(cd) = chosen else {
+            return false;
+        };
+        let apex = if cd.id == NEW {
+            self.stats.new_vertices += 1;
+            self.new_point(cd.p)
+        } else {
+            cd.id
+        };
+        self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid);
+        true
+    }
+
+    fn nearest_front_vertex(&self, p: P3, r: f64) -> f64 {
+        let found = self
+            .vtree
+            .query(&p)
+            .within::<SquaredEuclidean<f64>>(r * r)
+            .unsorted()
+            .execute();
+        found
+            .iter()
+            .map(|x| x.distance.sqrt())
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    fn insert_tet(&mut self, t: [u32; 4], base: u32) {
+        let tp = [0, 1, 2, 3].map(|k| self.pts[t[k] as usize]);
+        self.volume_done += tet_det(tp[0], tp[1], tp[2], tp[3]) / 6.0;
+        self.tets.push(t);
+        self.tet_alive.push(true);
+        self.kill_face(base);
+        for g in &TET_OUT_FACES[1..] {
+            let v = [t[g[0]], t[g[1]], t[g[2]]];
+            match self.face_map.get(&key3(v)) {
+                Some(&other) => self.kill_face(other),
+                None => self.add_face(v),
+            }
+        }
+    }
+}
+
+/// Face size for the queue: longest edge (smallest faces first).
+fn face_size(p: &[P3; 3]) -> f64 {
+    dist2(p[0], p[1])
+        .max(dist2(p[1], p[2]))
+        .max(dist2(p[2], p[0]))
+}
+
+/// TEMPORARY sampled check until geom::bezier lands.
+fn curved_valid(x: &[P3; 10]) -> bool {
+    let n = 6;
+    for i in 0..=n {
+        for j in 0..=n - i {
+            for k in 0..=n - i - j {
+                let xi = [
+                    i as f64 / n as f64,
+                    j as f64 / n as f64,
+                    k as f64 / n as f64,
+                ];
+                if tet10_det_jacobian(x, xi) <= 0.0 {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Run the front on a checked surface's arrays.
+pub fn run_front(
+    surf_nodes: &[P3],
+    surf_tris: &[[u32; 6]],
+    opts: &Options,
+    size: SizeField,
+    progress: Progress,
+) -> Result<FrontOutput> {
+    let mut m = Mesher::new(surf_nodes, surf_tris, opts, size);
+    m.run(progress)?;
+    let tets: Vec<[u32; 4]> = m
+        .tets
+        .iter()
+        .zip(&m.tet_alive)
+        .filter(|(_, a)| **a)
+        .map(|(t, _)| *t)
+        .collect();
+    Ok(FrontOutput {
+        pts: m.pts,
+        tets,
+        stats: m.stats,
+    })
+}

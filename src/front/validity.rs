@@ -1,0 +1,179 @@
+//! Exact validity of a candidate tetrahedron against the active front (paper 2.5).
+//!
+//! A candidate T = (a, b, c, p) on front face (a, b, c) is valid when it lies in the
+//! closure of the unmeshed region: p strictly on the inner side of (a, b, c), no front
+//! vertex in closed T (other than T's own), no new edge of T crossing a front face and no
+//! front edge crossing a new face of T (shared vertices and edges excepted, decided by
+//! ids), and any front face with T's three vertices being exactly a new face of T with the
+//! opposite orientation (it then closes). Every decision is an exact predicate.
+//!
+//! The same pass measures the paper's edge-face angle: for each front face F sharing an
+//! edge with T, the angle of the unmeshed wedge left between F and T. A thin wedge would
+//! force a sliver later.
+
+use super::grid::Aabb;
+use crate::geom::predicates::{orient3d, point_in_closed_tet, segment_triangle_conflict};
+use crate::geom::vec3::*;
+
+/// Outward faces of a positive tet (v0, v1, v2, v3), by local vertex index; face k is
+/// opposite vertex k... except ordering: [base(opposite v3), opp v2, opp v0, opp v1].
+pub const TET_OUT_FACES: [[usize; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+
+/// The outcome of a validity test.
+#[derive(Clone, Copy, Debug)]
+pub struct Verdict {
+    /// Smallest unmeshed wedge angle (degrees) between T and a front face sharing an edge
+    /// with it; 360 when there is none.
+    pub min_gap_deg: f64,
+}
+
+/// One front face as the validity test sees it.
+#[derive(Clone, Copy)]
+pub struct FaceRef {
+    /// Vertex ids, oriented with the normal into the unmeshed region.
+    pub v: [u32; 3],
+}
+
+/// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
+/// front, t[3] the apex) against the front faces `near` (excluding the base face).
+/// Returns `None` on any conflict.
+thread_local! { pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
+fn why(s: String) {
+    WHY.with(|w| *w.borrow_mut() = s);
+}
+
+pub fn check(
+    t: [u32; 4],
+    tp: [P3; 4],
+    near: &[FaceRef],
+    pos: impl Fn(u32) -> P3,
+) -> Option<Verdict> {
+    if orient3d(tp[0], tp[1], tp[2], tp[3]) <= 0 {
+        return None;
+    }
+    let tb = Aabb::of(&tp);
+    let mut min_gap = 360.0f64;
+    for f in near {
+        let fv = f.v;
+        let fp = [pos(fv[0]), pos(fv[1]), pos(fv[2])];
+        if !Aabb::of(&fp).overlaps(&tb) {
+            continue;
+        }
+        let in_t = |id: u32| t.iter().position(|&x| x == id);
+        let loc = [in_t(fv[0]), in_t(fv[1]), in_t(fv[2])];
+        let shared = loc.iter().filter(|x| x.is_some()).count();
+        if shared == 3 {
+            // F has T's three vertices: it must be a new face of T, oppositely oriented.
+            let l = [loc[0].unwrap(), loc[1].unwrap(), loc[2].unwrap()];
+            if !l.contains(&3) {
+                why(format!("copy of base {:?}", fv));
+                return None; // a second copy of the base face
+            }
+            // Outward new faces of T are (0,1,3), (1,2,3), (2,0,3); F must be a cyclic
+            // rotation of one of them reversed, i.e. a rotation of (1,0,3), (2,1,3), (0,2,3).
+            let rot = |a: [usize; 3]| [a, [a[1], a[2], a[0]], [a[2], a[0], a[1]]];
+            let ok = [[1, 0, 3], [2, 1, 3], [0, 2, 3]]
+                .iter()
+                .any(|g| rot(*g).contains(&l));
+            if !ok {
+                why(format!("same-orientation face {:?}", fv));
+                return None;
+            }
+            continue;
+        }
+        if shared == 2 {
+            // Unmeshed wedge between F and T at their shared edge.
+            let (e0, e1, fo) = match loc {
+                [Some(a), Some(b), None] => (a, b, fp[2]),
+                [None, Some(a), Some(b)] => (a, b, fp[0]),
+                [Some(b), None, Some(a)] => (a, b, fp[1]),
+                _ => (0, 1, fp[0]), // unreachable: exactly two are shared
+            };
+            let g = wedge_gap_deg(tp, e0, e1, fo, tri_normal(fp[0], fp[1], fp[2]));
+            min_gap = min_gap.min(g);
+        }
+        if separated(&t, &tp, &fv, &fp) {
+            continue;
+        }
+        // Front vertices inside closed T.
+        for k in 0..3 {
+            if loc[k].is_none() && point_in_closed_tet(fp[k], tp[0], tp[1], tp[2], tp[3]) {
+                why(format!("vertex {} of {:?} inside", fv[k], fv));
+                return None;
+            }
+        }
+        // New edges of T against F.
+        for i in 0..3 {
+            if segment_triangle_conflict([tp[i], tp[3]], [t[i], t[3]], fp, fv) {
+                why(format!("new edge {} crosses {:?}", i, fv));
+                return None;
+            }
+        }
+        // Edges of F against the new faces of T.
+        for k in 0..3 {
+            let (i, j) = (k, (k + 1) % 3);
+            let (ei, ej) = (fv[i], fv[j]);
+            if loc[i].is_some() && loc[j].is_some() {
+                continue; // an edge of T itself
+            }
+            for g in &TET_OUT_FACES[1..] {
+                let gid = [t[g[0]], t[g[1]], t[g[2]]];
+                let gp = [tp[g[0]], tp[g[1]], tp[g[2]]];
+                if segment_triangle_conflict([fp[i], fp[j]], [ei, ej], gp, gid) {
+                    why(format!(
+                        "edge {ei}-{ej} of {:?} crosses new face {:?}",
+                        fv, gid
+                    ));
+                    return None;
+                }
+            }
+        }
+    }
+    Some(Verdict {
+        min_gap_deg: min_gap,
+    })
+}
+
+/// Is F strictly outside one of T's face planes (touching only at T's own vertices on
+/// that face)? Cheap early exit for most nearby faces.
+fn separated(t: &[u32; 4], tp: &[P3; 4], fv: &[u32; 3], fp: &[P3; 3]) -> bool {
+    'faces: for face in &TET_OUT_FACES {
+        let (x, y, z) = (tp[face[0]], tp[face[1]], tp[face[2]]);
+        for k in 0..3 {
+            if face.iter().any(|&i| t[i] == fv[k]) {
+                continue;
+            }
+            if orient3d(x, y, z, fp[k]) <= 0 {
+                continue 'faces;
+            }
+        }
+        return true;
+    }
+    false
+}
+
+/// Angle (degrees) swept from front face F's half-plane at edge (tp[e0], tp[e1]), turning
+/// towards F's normal `nf`, until the first face of T containing that edge.
+fn wedge_gap_deg(tp: [P3; 4], e0: usize, e1: usize, f_other: P3, nf: P3) -> f64 {
+    let u = tp[e0];
+    let t = normalize(sub(tp[e1], u));
+    let perp = |x: P3| {
+        let d = sub(x, u);
+        sub(d, scale(t, dot(d, t)))
+    };
+    let e1v = normalize(perp(f_other));
+    let e2v = normalize(sub(nf, scale(t, dot(nf, t))));
+    let mut best = 360.0f64;
+    for k in 0..4 {
+        if k == e0 || k == e1 {
+            continue;
+        }
+        let x = perp(tp[k]);
+        let mut ang = dot(x, e2v).atan2(dot(x, e1v)).to_degrees();
+        if ang < 0.0 {
+            ang += 360.0;
+        }
+        best = best.min(ang);
+    }
+    best
+}

@@ -1,0 +1,70 @@
+//! Assemble the P2 mesh from the front's straight-sided tets: boundary edges take the
+//! input mid nodes, every other edge gets one new node at its midpoint (shared by all tets
+//! of the edge), unused interior points are dropped, surface nodes keep their indices.
+
+use super::TetMesh;
+use crate::geom::shape::{TET10_EDGES, TRI6_EDGES};
+use crate::geom::vec3::{mid, P3};
+use std::collections::HashMap;
+
+/// Build the 10-node mesh. `pts[..n_surf]` are the surface nodes, the rest interior vertices.
+pub fn assemble(
+    pts: &[P3],
+    tets: &[[u32; 4]],
+    n_surf: usize,
+    surf_tris: &[[u32; 6]],
+    surf_tags: &[i32],
+) -> TetMesh {
+    let mut bedge: HashMap<(u32, u32), u32> = HashMap::with_capacity(surf_tris.len() * 3 / 2);
+    for t in surf_tris {
+        for (k, [i, j]) in TRI6_EDGES.iter().enumerate() {
+            let (a, b) = (t[*i], t[*j]);
+            bedge.insert((a.min(b), a.max(b)), t[3 + k]);
+        }
+    }
+    // Renumber interior vertices in order of first use (deterministic).
+    let mut remap = vec![u32::MAX; pts.len()];
+    let mut nodes: Vec<P3> = pts[..n_surf].to_vec();
+    for (i, r) in remap.iter_mut().enumerate().take(n_surf) {
+        *r = i as u32;
+    }
+    for t in tets {
+        for &v in t {
+            if remap[v as usize] == u32::MAX {
+                remap[v as usize] = nodes.len() as u32;
+                nodes.push(pts[v as usize]);
+            }
+        }
+    }
+    let mut emid: HashMap<(u32, u32), u32> = HashMap::with_capacity(tets.len() * 2);
+    let mut out = Vec::with_capacity(tets.len());
+    for t in tets {
+        let c = t.map(|v| remap[v as usize]);
+        let mut x = [0u32; 10];
+        x[..4].copy_from_slice(&c);
+        for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
+            let (a, b) = (c[*i], c[*j]);
+            let key = (a.min(b), a.max(b));
+            x[4 + k] = if let Some(&m) = bedge.get(&key) {
+                m
+            } else {
+                *emid.entry(key).or_insert_with(|| {
+                    nodes.push(mid(nodes[a as usize], nodes[b as usize]));
+                    (nodes.len() - 1) as u32
+                })
+            };
+        }
+        out.push(x);
+    }
+    let tags = if surf_tags.len() == surf_tris.len() {
+        surf_tags.to_vec()
+    } else {
+        vec![0; surf_tris.len()]
+    };
+    TetMesh {
+        nodes,
+        tets: out,
+        boundary: surf_tris.to_vec(),
+        boundary_tags: tags,
+    }
+}

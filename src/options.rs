@@ -1,0 +1,96 @@
+//! Options of [`crate::generate`], with the paper's defaults.
+
+use crate::{Error, Result};
+
+/// How the target element size is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SizeMode {
+    /// Graded from the boundary (default): local size at each surface vertex from its
+    /// edges, extended inward with a limited growth rate, never above the largest
+    /// boundary size. Works on surfaces with mixed triangle sizes.
+    Graded,
+    /// The paper's uniform size: tetrahedron height from the mean curved triangle area
+    /// (paper eq. 1, with the square root that makes it dimensionally a length).
+    Uniform,
+    /// A uniform target edge length given by the user.
+    Fixed(f64),
+}
+
+/// Options of mesh generation. `Options::default()` gives the paper's settings.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Search radius factor: candidates within `alpha * h` of the ideal point (paper: 1.5).
+    pub alpha: f64,
+    /// How the target size is chosen.
+    pub size: SizeMode,
+    /// Growth rate of the graded size field (size increase per unit distance / size).
+    pub gradation: f64,
+    /// Run the quality improvement and high-order optimization after generation.
+    pub optimize: bool,
+    /// Worker threads for parallel stages; 0 = all cores. Results never depend on it.
+    pub threads: usize,
+    /// Minimum dihedral angle of a candidate, degrees (paper: 15).
+    pub min_dihedral_deg: f64,
+    /// Maximum equiangular skewness of a candidate unless nothing better exists (paper: 0.9).
+    pub max_skewness: f64,
+    /// Minimum angle between a new face and a front face sharing its edge, degrees
+    /// (paper's edge-face angle: 10).
+    pub min_edge_face_angle_deg: f64,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            alpha: 1.5,
+            size: SizeMode::Graded,
+            gradation: 0.2,
+            optimize: true,
+            threads: 0,
+            min_dihedral_deg: 15.0,
+            max_skewness: 0.9,
+            min_edge_face_angle_deg: 10.0,
+        }
+    }
+}
+
+impl Options {
+    /// Check every option; a bad one is an [`Error::InvalidArgument`] naming it.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.alpha.is_finite() && self.alpha > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "alpha must be a finite number > 0 (got {})",
+                self.alpha
+            )));
+        }
+        if let SizeMode::Fixed(h) = self.size {
+            if !(h.is_finite() && h > 0.0) {
+                return Err(Error::InvalidArgument(format!(
+                    "size must be a finite number > 0 (got {h})"
+                )));
+            }
+        }
+        if !(self.gradation.is_finite() && self.gradation > 0.0) {
+            return Err(Error::InvalidArgument(format!(
+                "gradation must be a finite number > 0 (got {})",
+                self.gradation
+            )));
+        }
+        for (name, v, lo, hi) in [
+            ("min dihedral angle", self.min_dihedral_deg, 0.0, 70.0),
+            ("max skewness", self.max_skewness, 0.0, 1.0),
+            (
+                "min edge-face angle",
+                self.min_edge_face_angle_deg,
+                0.0,
+                60.0,
+            ),
+        ] {
+            if !(v.is_finite() && v >= lo && v <= hi) {
+                return Err(Error::InvalidArgument(format!(
+                    "{name} must be in [{lo}, {hi}] (got {v})"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
