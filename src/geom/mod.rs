@@ -3,6 +3,7 @@
 
 pub mod bezier;
 pub mod predicates;
+pub mod quadrature;
 pub mod shape;
 #[cfg(test)]
 mod testutil;
