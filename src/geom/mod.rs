@@ -4,6 +4,7 @@
 pub mod bezier;
 pub mod predicates;
 pub mod quadrature;
+pub mod quality;
 pub mod shape;
 #[cfg(test)]
 mod testutil;
