@@ -56,9 +56,12 @@ pub const BEZIER_INDEX: [[u8; 4]; 20] = [
     [1, 1, 1, 0],
 ];
 
-/// Coefficient slot of each ordered triple (i, j, k) (index 16 i + 4 j + k).
+/// Coefficient slot of each ordered triple (i, j, k) (index 16 i + 4 j + k); the
+/// reference for the hand-expanded [`coeffs_from_columns`] (checked in the tests).
+#[cfg(test)]
 const TRIPLE_SLOT: [u8; 64] = triple_slots();
 
+#[cfg(test)]
 const fn triple_slots() -> [u8; 64] {
     let mut out = [0u8; 64];
     let mut t = 0;
@@ -81,6 +84,7 @@ const fn triple_slots() -> [u8; 64] {
 }
 
 /// 1 / (number of ordered triples with the slot's multiset) = a! / 3!.
+#[cfg(test)]
 const SLOT_WEIGHT: [f64; 20] = {
     let mut w = [0.0; 20];
     let mut s = 0;
@@ -117,8 +121,7 @@ const MAX_ACTIVE: usize = 128;
 pub struct LinearJacobian {
     /// cols[d][j]: coefficient of l_j in column d.
     pub cols: [[P3; 4]; 3],
-    /// Largest coordinate offset |x_i - x_0| (max norm) of the ten nodes; scales the
-    /// rounding margin.
+    /// Largest distance |x_i - x_0| of a node from corner 0; scales the rounding margin.
     pub extent: f64,
 }
 
@@ -127,11 +130,16 @@ impl LinearJacobian {
     #[inline]
     pub fn new(x: &[P3; 10]) -> Self {
         let mut y = [[0.0; 3]; 10];
-        let mut extent: f64 = 0.0;
+        let mut e2 = 0.0;
         for i in 1..10 {
             y[i] = sub(x[i], x[0]);
-            extent = extent.max(y[i][0].abs().max(y[i][1].abs()).max(y[i][2].abs()));
+            let n2 = dot(y[i], y[i]);
+            // (A plain comparison, not f64::max: cheaper, and NaN input is caught later.)
+            if n2 > e2 {
+                e2 = n2;
+            }
         }
+        let extent = e2.sqrt();
         // Mid node (relative to x0) of the edge {a, b}.
         let m = |a: usize, b: usize| -> P3 {
             match (a.min(b), a.max(b)) {
@@ -226,8 +234,9 @@ impl LinearJacobian {
         let mut c = [0.0f64; 3];
         for (cd, col) in c.iter_mut().zip(self.cols.iter()) {
             for v in col {
-                *cd = cd.max(dot(*v, *v).sqrt());
+                *cd = cd.max(dot(*v, *v));
             }
+            *cd = cd.sqrt();
         }
         16.0 * u * c[0] * c[1] * c[2]
             + 128.0 * u * self.extent * (c[0] * c[1] + c[0] * c[2] + c[1] * c[2])
@@ -240,19 +249,53 @@ pub fn bary(xi: [f64; 3]) -> [f64; 4] {
     [1.0 - xi[0] - xi[1] - xi[2], xi[0], xi[1], xi[2]]
 }
 
-/// Bernstein coefficients of the cubic det[c_0(l), c_1(l), c_2(l)] for linear columns.
+/// Bernstein coefficients of the cubic det[c_0(l), c_1(l), c_2(l)] for linear columns:
+/// coefficient `a` is the mean of det[c_0[i], c_1[j], c_2[k]] over the ordered triples
+/// (i, j, k) with multiset `a` (written out, so every index is a constant).
 #[inline]
 fn coeffs_from_columns(c: &[[P3; 4]; 3]) -> [f64; 20] {
+    const THIRD: f64 = 1.0 / 3.0;
+    const SIXTH: f64 = 1.0 / 6.0;
     let mut x = [[0.0; 3]; 16];
     for j in 0..4 {
         for k in 0..4 {
             x[4 * j + k] = cross(c[1][j], c[2][k]);
         }
     }
+    let d = |i: usize, j: usize, k: usize| dot(c[0][i], x[4 * j + k]);
+    [
+        d(0, 0, 0),
+        d(1, 1, 1),
+        d(2, 2, 2),
+        d(3, 3, 3),
+        (d(0, 0, 1) + d(0, 1, 0) + d(1, 0, 0)) * THIRD,
+        (d(0, 1, 1) + d(1, 0, 1) + d(1, 1, 0)) * THIRD,
+        (d(1, 1, 2) + d(1, 2, 1) + d(2, 1, 1)) * THIRD,
+        (d(1, 2, 2) + d(2, 1, 2) + d(2, 2, 1)) * THIRD,
+        (d(0, 2, 2) + d(2, 0, 2) + d(2, 2, 0)) * THIRD,
+        (d(0, 0, 2) + d(0, 2, 0) + d(2, 0, 0)) * THIRD,
+        (d(0, 3, 3) + d(3, 0, 3) + d(3, 3, 0)) * THIRD,
+        (d(0, 0, 3) + d(0, 3, 0) + d(3, 0, 0)) * THIRD,
+        (d(2, 3, 3) + d(3, 2, 3) + d(3, 3, 2)) * THIRD,
+        (d(2, 2, 3) + d(2, 3, 2) + d(3, 2, 2)) * THIRD,
+        (d(1, 3, 3) + d(3, 1, 3) + d(3, 3, 1)) * THIRD,
+        (d(1, 1, 3) + d(1, 3, 1) + d(3, 1, 1)) * THIRD,
+        (d(1, 2, 3) + d(1, 3, 2) + d(2, 1, 3) + d(2, 3, 1) + d(3, 1, 2) + d(3, 2, 1)) * SIXTH,
+        (d(0, 2, 3) + d(0, 3, 2) + d(2, 0, 3) + d(2, 3, 0) + d(3, 0, 2) + d(3, 2, 0)) * SIXTH,
+        (d(0, 1, 3) + d(0, 3, 1) + d(1, 0, 3) + d(1, 3, 0) + d(3, 0, 1) + d(3, 1, 0)) * SIXTH,
+        (d(0, 1, 2) + d(0, 2, 1) + d(1, 0, 2) + d(1, 2, 0) + d(2, 0, 1) + d(2, 1, 0)) * SIXTH,
+    ]
+}
+
+/// The table-driven version of [`coeffs_from_columns`], for the tests.
+#[cfg(test)]
+fn coeffs_by_table(c: &[[P3; 4]; 3]) -> [f64; 20] {
     let mut b = [0.0; 20];
     for i in 0..4 {
-        for (jk, xjk) in x.iter().enumerate() {
-            b[TRIPLE_SLOT[16 * i + jk] as usize] += dot(c[0][i], *xjk);
+        for j in 0..4 {
+            for k in 0..4 {
+                b[TRIPLE_SLOT[16 * i + 4 * j + k] as usize] += det3(c[0][i], c[1][j], c[2][k]);
+            }
         }
     }
     for (v, w) in b.iter_mut().zip(SLOT_WEIGHT.iter()) {
@@ -355,6 +398,9 @@ pub struct JacobianBounds {
     pub max_upper: f64,
     /// How many sub-tets were evaluated (0 when the element's own coefficients sufficed).
     pub subdomains: u32,
+    /// True when the work limits stopped the refinement before the tolerance was met
+    /// (the bounds are still valid, only looser).
+    pub exhausted: bool,
 }
 
 impl JacobianBounds {
@@ -432,7 +478,7 @@ pub fn certify(x: &[P3; 10]) -> Certificate {
     if let Some((point, value)) = r.witness {
         return Certificate::Invalid { point, value };
     }
-    let min_lower = r.lower_min() - tau;
+    let min_lower = r.settled_min - tau;
     if r.exhausted || min_lower.is_nan() || min_lower <= 0.0 {
         Certificate::Undecided {
             min_lower: if min_lower.is_nan() {
@@ -460,6 +506,7 @@ pub fn jacobian_bounds(x: &[P3; 10], rel_tol: f64) -> JacobianBounds {
             max_lower: d,
             max_upper: d,
             subdomains: 0,
+            exhausted: false,
         };
     }
     let lj = LinearJacobian::new(x);
@@ -473,17 +520,19 @@ pub fn jacobian_bounds(x: &[P3; 10], rel_tol: f64) -> JacobianBounds {
             max_lower: f64::NAN,
             max_upper: f64::NAN,
             subdomains: 0,
+            exhausted: true,
         };
     }
     let mut r = Refiner::new(x, &lj, tau, Goal::Ratio(rel_tol.max(0.0)));
     r.run(b);
     JacobianBounds {
-        min_lower: r.lower_min() - tau,
+        min_lower: r.settled_min - tau,
         min_upper: r.m_hi,
         min_point: r.m_hi_point,
         max_lower: r.big_lo,
-        max_upper: r.upper_max() + tau,
+        max_upper: r.settled_max + tau,
         subdomains: r.evals,
+        exhausted: r.exhausted,
     }
 }
 
@@ -587,6 +636,19 @@ const EMPTY_LEAF: Leaf = Leaf {
     depth: 0,
 };
 
+/// Per-pass thresholds of the settling test (see [`Refiner::need`]).
+#[derive(Clone, Copy)]
+struct Thresholds {
+    min_at: f64,
+    min_inv: f64,
+    max_at: f64,
+    max_inv: f64,
+}
+
+/// Best-first adaptive refinement: keeps a set of unsettled sub-tets, repeatedly splits
+/// the one whose bounds are furthest from good enough, and folds settled sub-tets into
+/// running bounds. The leaf storage lives on the stack of [`Refiner::run`] and is only
+/// created when the root is not already settled.
 struct Refiner<'a> {
     x: &'a [P3; 10],
     lj: &'a LinearJacobian,
@@ -597,11 +659,9 @@ struct Refiner<'a> {
     m_hi_point: [f64; 3],
     /// Largest actual det J value seen.
     big_lo: f64,
-    /// min / max coefficient over leaves taken out of the active set.
+    /// min / max coefficient over settled leaves (all leaves once `run` returns).
     settled_min: f64,
     settled_max: f64,
-    active: [Leaf; MAX_ACTIVE],
-    n: usize,
     evals: u32,
     exhausted: bool,
     witness: Option<([f64; 3], f64)>,
@@ -619,24 +679,10 @@ impl<'a> Refiner<'a> {
             big_lo: f64::NEG_INFINITY,
             settled_min: f64::INFINITY,
             settled_max: f64::NEG_INFINITY,
-            active: [EMPTY_LEAF; MAX_ACTIVE],
-            n: 0,
             evals: 0,
             exhausted: false,
             witness: None,
         }
-    }
-
-    fn lower_min(&self) -> f64 {
-        self.active[..self.n]
-            .iter()
-            .fold(self.settled_min, |a, l| a.min(l.min))
-    }
-
-    fn upper_max(&self) -> f64 {
-        self.active[..self.n]
-            .iter()
-            .fold(self.settled_max, |a, l| a.max(l.max))
     }
 
     /// Records an actual value of det J at reference point p.
@@ -660,7 +706,8 @@ impl<'a> Refiner<'a> {
     }
 
     /// Builds a leaf from its coefficients, recording the actual values it exposes: the
-    /// corner coefficients and det J at the control points of the extreme coefficients.
+    /// corner coefficients and det J at the control points of the extreme coefficients
+    /// (within O(h^2) of them, which is what makes the stopping test converge).
     fn leaf(&mut self, v: [[f64; 3]; 4], b: &[f64; 20], depth: u8) -> Leaf {
         let (mut kmin, mut kmax) = (0, 0);
         for k in 1..20 {
@@ -696,30 +743,40 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    /// How much refining this leaf is worth (> 0), or None when it is settled.
-    #[inline]
-    fn need(&self, l: &Leaf) -> Option<f64> {
+    fn thresholds(&self) -> Thresholds {
         match self.goal {
-            Goal::Sign => {
-                if l.min > self.tau {
-                    None
-                } else {
-                    Some(-l.min)
-                }
-            }
+            Goal::Sign => Thresholds {
+                min_at: self.tau,
+                min_inv: 1.0,
+                max_at: f64::INFINITY,
+                max_inv: 0.0,
+            },
             Goal::Ratio(tol) => {
+                // Settled when min >= m_hi (1 - tol/2) and max <= big_lo (1 + tol/2):
+                // then the ratio of the bounds is within ~tol of the ratio of values.
                 let t = 0.5 * tol;
-                let scale_m = self.m_hi.abs().max(self.tau);
-                let scale_big = self.big_lo.abs().max(self.tau);
-                let gm = (self.m_hi - t * scale_m - l.min) / scale_m;
-                let gb = (l.max - self.big_lo - t * scale_big) / scale_big;
-                let g = gm.max(gb);
-                if g > 0.0 {
-                    Some(g)
-                } else {
-                    None
+                let sm = self.m_hi.abs().max(self.tau);
+                let sb = self.big_lo.abs().max(self.tau);
+                Thresholds {
+                    min_at: self.m_hi - t * sm,
+                    min_inv: 1.0 / sm,
+                    max_at: self.big_lo + t * sb,
+                    max_inv: 1.0 / sb,
                 }
             }
+        }
+    }
+
+    /// How far (relative) this leaf is from settled (> 0), or None when it is settled.
+    #[inline]
+    fn need(th: &Thresholds, l: &Leaf) -> Option<f64> {
+        let g = ((th.min_at - l.min) * th.min_inv).max((l.max - th.max_at) * th.max_inv);
+        if g > 0.0 {
+            Some(g)
+        } else if g.is_nan() && (l.min.is_nan() || l.max.is_nan()) {
+            Some(f64::INFINITY)
+        } else {
+            None
         }
     }
 
@@ -732,67 +789,72 @@ impl<'a> Refiner<'a> {
         }
     }
 
+    #[inline]
+    fn settle(&mut self, l: &Leaf) {
+        self.settled_min = self.settled_min.min(l.min);
+        self.settled_max = self.settled_max.max(l.max);
+    }
+
+    /// Refines until every leaf is settled, an answer is found, or the work limits are
+    /// hit; afterwards `settled_min` / `settled_max` bound det J over the whole element.
     fn run(&mut self, root_coeffs: [f64; 20]) {
         let root = self.leaf(ROOT, &root_coeffs, 0);
-        self.active[0] = root;
-        self.n = 1;
-        loop {
-            if self.done() {
-                return;
-            }
+        if self.done() || Self::need(&self.thresholds(), &root).is_none() {
+            self.settle(&root);
+            return;
+        }
+        let mut active = [EMPTY_LEAF; MAX_ACTIVE];
+        active[0] = root;
+        let mut n = 1;
+        while !self.done() {
             // Settle what needs no more work; pick the neediest of the rest.
+            let th = self.thresholds();
             let mut best: Option<(usize, f64)> = None;
             let mut i = 0;
-            while i < self.n {
-                let l = self.active[i];
-                match self.need(&l) {
-                    None => {
-                        self.settled_min = self.settled_min.min(l.min);
-                        self.settled_max = self.settled_max.max(l.max);
-                        self.n -= 1;
-                        self.active[i] = self.active[self.n];
+            while i < n {
+                let l = active[i];
+                let g = match Self::need(&th, &l) {
+                    Some(g) if l.depth < MAX_DEPTH => g,
+                    other => {
+                        // Settled, or cannot be refined (keep its valid, loose bounds).
+                        self.exhausted |= other.is_some();
+                        self.settle(&l);
+                        n -= 1;
+                        active[i] = active[n];
+                        continue;
                     }
-                    Some(g) => {
-                        if l.depth >= MAX_DEPTH {
-                            // Cannot refine: keep its (valid, loose) bounds.
-                            self.exhausted = true;
-                            self.settled_min = self.settled_min.min(l.min);
-                            self.settled_max = self.settled_max.max(l.max);
-                            self.n -= 1;
-                            self.active[i] = self.active[self.n];
-                            continue;
-                        }
-                        let better = match best {
-                            None => true,
-                            Some((_, bg)) => g > bg,
-                        };
-                        if better {
-                            best = Some((i, g));
-                        }
-                        i += 1;
-                    }
+                };
+                let better = match best {
+                    None => true,
+                    Some((_, bg)) => g > bg,
+                };
+                if better {
+                    best = Some((i, g));
                 }
+                i += 1;
             }
             let Some((i, _)) = best else {
-                return;
+                break;
             };
-            if self.n + 7 > MAX_ACTIVE || self.evals + 8 > MAX_SUBDOMAINS {
+            if n + 7 > MAX_ACTIVE || self.evals + 8 > MAX_SUBDOMAINS {
                 self.exhausted = true;
-                return;
+                break;
             }
-            let parent = self.active[i];
-            let kids = red_children(&parent.v);
-            for (c, kv) in kids.iter().enumerate() {
+            let parent = active[i];
+            for (c, kv) in red_children(&parent.v).iter().enumerate() {
                 let b = self.lj.bezier_on(kv);
                 self.evals += 1;
                 let leaf = self.leaf(*kv, &b, parent.depth + 1);
                 if c == 0 {
-                    self.active[i] = leaf;
+                    active[i] = leaf;
                 } else {
-                    self.active[self.n] = leaf;
-                    self.n += 1;
+                    active[n] = leaf;
+                    n += 1;
                 }
             }
+        }
+        for l in &active[..n] {
+            self.settle(l);
         }
     }
 }
@@ -832,6 +894,19 @@ mod tests {
             assert_eq!(BEZIER_INDEX[4 + 2 * k][*b], 1);
             assert_eq!(BEZIER_INDEX[5 + 2 * k][*a], 1);
             assert_eq!(BEZIER_INDEX[5 + 2 * k][*b], 2);
+        }
+    }
+
+    #[test]
+    fn expanded_coefficients_match_the_table() {
+        let mut rng = StdRng::seed_from_u64(8);
+        for _ in 0..50 {
+            let lj = LinearJacobian::new(&random_curved(&mut rng, 0.5));
+            let a = coeffs_from_columns(&lj.cols);
+            let b = coeffs_by_table(&lj.cols);
+            for (u, v) in a.iter().zip(b.iter()) {
+                assert!((u - v).abs() <= 1e-14 * u.abs().max(1.0), "{u} vs {v}");
+            }
         }
     }
 

@@ -14,7 +14,7 @@ use serde::Serialize;
 use super::bezier::{is_straight, scaled_jacobian_certified, LinearJacobian};
 use super::quadrature::CompensatedSum;
 use super::shape::TET10_EDGES;
-use super::vec3::{cross, dot, norm, sub, tet_det, P3};
+use super::vec3::{add, cross, det3, dot, norm, scale, sub, tet_det, P3};
 
 /// The dihedral angle of the regular tetrahedron, acos(1/3) in degrees (70.5288°):
 /// theta_e of the equiangular skewness.
@@ -33,13 +33,13 @@ fn face_normals(c: &[P3; 4]) -> [P3; 4] {
     [n(1, 2, 3), n(0, 3, 2), n(0, 1, 3), n(0, 2, 1)]
 }
 
-/// Interior dihedral angles in degrees of the tet with corners `c`, at its six edges in
-/// [`TET10_EDGES`] order ((0,1), (1,2), (2,0), (3,0), (3,2), (3,1)). Computed with atan2,
-/// so accurate near 0° and 180° too; 0 at an edge whose face is degenerate.
+/// For each edge in [`TET10_EDGES`] order, (s, c) with atan2(s, c) the interior dihedral
+/// angle: s = |n_a x n_b| >= 0 and c = -n_a . n_b for the outward normals of the two faces
+/// through the edge (the interior angle is pi minus the angle between them).
 #[inline]
-pub fn dihedral_angles(c: &[P3; 4]) -> [f64; 6] {
+fn dihedral_sc(c: &[P3; 4]) -> [(f64, f64); 6] {
     let n = face_normals(c);
-    let mut out = [0.0; 6];
+    let mut out = [(0.0, 0.0); 6];
     for (o, [a, b]) in out.iter_mut().zip(TET10_EDGES.iter()) {
         // The two faces through edge (a, b) are those opposite the other two corners.
         let mut other = [0usize; 2];
@@ -51,10 +51,60 @@ pub fn dihedral_angles(c: &[P3; 4]) -> [f64; 6] {
             }
         }
         let (p, q) = (n[other[0]], n[other[1]]);
-        // Interior angle = pi - angle between the outward normals.
-        *o = norm(cross(p, q)).atan2(-dot(p, q)).to_degrees();
+        // `+ 0.0` turns -0 into +0, so a degenerate face gives atan2(0, 0) = 0, not 180°.
+        *o = (norm(cross(p, q)), -dot(p, q) + 0.0);
     }
     out
+}
+
+/// Interior dihedral angles in degrees of the tet with corners `c`, at its six edges in
+/// [`TET10_EDGES`] order ((0,1), (1,2), (2,0), (3,0), (3,2), (3,1)). Computed with atan2,
+/// so accurate near 0° and 180° too; 0 at an edge next to a degenerate (zero-area) face.
+/// Independent of the tet's orientation.
+#[inline]
+pub fn dihedral_angles(c: &[P3; 4]) -> [f64; 6] {
+    let sc = dihedral_sc(c);
+    let mut out = [0.0; 6];
+    for (o, (s, cs)) in out.iter_mut().zip(sc.iter()) {
+        *o = s.atan2(*cs).to_degrees();
+    }
+    out
+}
+
+/// The smallest and largest of [`dihedral_angles`] (degrees), with two atan2 instead of
+/// six: the angles are ordered by the sign of s_a c_b - c_a s_b = k sin(theta_a -
+/// theta_b), k > 0. Angles equal to within rounding may be picked either way.
+#[inline]
+pub fn dihedral_extremes(c: &[P3; 4]) -> (f64, f64) {
+    let sc = dihedral_sc(c);
+    let (mut lo, mut hi) = (0, 0);
+    for (i, (s, cs)) in sc.iter().enumerate() {
+        if s.is_nan() || cs.is_nan() {
+            return (f64::NAN, f64::NAN);
+        }
+        // theta_i < theta_lo ?
+        if s * sc[lo].1 - cs * sc[lo].0 < 0.0 {
+            lo = i;
+        }
+        if s * sc[hi].1 - cs * sc[hi].0 > 0.0 {
+            hi = i;
+        }
+    }
+    (
+        sc[lo].0.atan2(sc[lo].1).to_degrees(),
+        sc[hi].0.atan2(sc[hi].1).to_degrees(),
+    )
+}
+
+/// Equiangular skewness from the smallest and largest dihedral angles (degrees): paper
+/// eq. 2, max[(θmax − θe)/(180 − θe), (θe − θmin)/θe].
+#[inline]
+pub fn skewness_from_extremes(min_deg: f64, max_deg: f64) -> f64 {
+    let te = EQUIANGULAR_DIHEDRAL_DEG;
+    if min_deg.is_nan() || max_deg.is_nan() {
+        return f64::NAN;
+    }
+    ((max_deg - te) / (180.0 - te)).max((te - min_deg) / te)
 }
 
 /// Equiangular skewness, paper eq. 2: max[(θmax − θe)/(180 − θe), (θe − θmin)/θe] over
@@ -62,19 +112,15 @@ pub fn dihedral_angles(c: &[P3; 4]) -> [f64; 6] {
 /// tet, → 1 for slivers, needles and caps. NaN angles give NaN.
 #[inline]
 pub fn equiangular_skewness(angles: &[f64; 6]) -> f64 {
-    let te = EQUIANGULAR_DIHEDRAL_DEG;
     let (mut lo, mut hi) = (angles[0], angles[0]);
-    for &a in &angles[1..] {
+    for &a in angles {
         if a.is_nan() {
             return f64::NAN;
         }
         lo = lo.min(a);
         hi = hi.max(a);
     }
-    if lo.is_nan() {
-        return f64::NAN;
-    }
-    ((hi - te) / (180.0 - te)).max((te - lo) / te)
+    skewness_from_extremes(lo, hi)
 }
 
 /// Scaled Jacobian min det J / max det J over the order-[`SAMPLE_ORDER`] lattice of the
@@ -87,19 +133,37 @@ pub fn scaled_jacobian_sampled(x: &[P3; 10]) -> f64 {
     if is_straight(x) {
         return sign_ratio(tet_det(x[0], x[1], x[2], x[3]));
     }
-    let lj = LinearJacobian::new(x);
+    // Columns of dx/dxi are linear: walk the lattice adding constant steps (9 adds and
+    // one 3x3 determinant per point).
+    let c = LinearJacobian::new(x).cols;
     let n = SAMPLE_ORDER;
     let h = 1.0 / n as f64;
+    let mut step = [[[0.0; 3]; 3]; 3]; // step[axis][column]
+    for (axis, st) in step.iter_mut().enumerate() {
+        for (d, s) in st.iter_mut().enumerate() {
+            *s = scale(sub(c[d][axis + 1], c[d][0]), h);
+        }
+    }
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for i in 0..=n {
         for j in 0..=n - i {
-            for k in 0..=n - i - j {
-                let v = lj.det([i as f64 * h, j as f64 * h, k as f64 * h]);
+            let mut col = [[0.0; 3]; 3];
+            for (d, cd) in col.iter_mut().enumerate() {
+                *cd = add(
+                    c[d][0],
+                    add(scale(step[0][d], i as f64), scale(step[1][d], j as f64)),
+                );
+            }
+            for _ in 0..=n - i - j {
+                let v = det3(col[0], col[1], col[2]);
                 if v.is_nan() {
                     return f64::NAN;
                 }
                 lo = lo.min(v);
                 hi = hi.max(v);
+                for (cd, st) in col.iter_mut().zip(step[2].iter()) {
+                    *cd = add(*cd, *st);
+                }
             }
         }
     }
@@ -144,17 +208,11 @@ pub struct TetQuality {
 /// Every quality measure of the 10-node tet `x` (Gmsh order). Dihedral angles and
 /// skewness use the four corners only, as the paper does.
 pub fn tet_quality(x: &[P3; 10]) -> TetQuality {
-    let c = [x[0], x[1], x[2], x[3]];
-    let ang = dihedral_angles(&c);
-    let (mut lo, mut hi) = (ang[0], ang[0]);
-    for &a in &ang[1..] {
-        lo = lo.min(a);
-        hi = hi.max(a);
-    }
+    let (lo, hi) = dihedral_extremes(&[x[0], x[1], x[2], x[3]]);
     TetQuality {
         scaled_jacobian: scaled_jacobian_sampled(x),
         scaled_jacobian_certified: scaled_jacobian_certified(x, DEFAULT_SJ_REL_TOL),
-        skewness: equiangular_skewness(&ang),
+        skewness: skewness_from_extremes(lo, hi),
         min_dihedral: lo,
         max_dihedral: hi,
     }
@@ -392,7 +450,7 @@ impl TetQualitySummary {
 mod tests {
     use super::super::bezier::jacobian_bounds;
     use super::super::shape::{straight_tet10, tet10_det_jacobian};
-    use super::super::testutil::{lattice, random_curved};
+    use super::super::testutil::{lattice, random_corners, random_curved};
     use super::*;
     use rand::rngs::StdRng;
     use rand::SeedableRng;
@@ -448,6 +506,47 @@ mod tests {
         sb.sort_by(f64::total_cmp);
         for (x, y) in sa.iter().zip(sb.iter()) {
             assert!((x - y).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn extremes_match_all_angles() {
+        let mut rng = StdRng::seed_from_u64(4);
+        for _ in 0..1000 {
+            let c = random_corners(&mut rng);
+            let x = straight_tet10(c);
+            let a = dihedral_angles(&c);
+            let lo = a.iter().cloned().fold(f64::INFINITY, f64::min);
+            let hi = a.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let (elo, ehi) = dihedral_extremes(&c);
+            assert!((elo - lo).abs() < 1e-12 && (ehi - hi).abs() < 1e-12);
+            let q = tet_quality(&x);
+            assert!((q.skewness - equiangular_skewness(&a)).abs() < 1e-14);
+            // Angle sum identities hold loosely: each angle is in (0, 180).
+            assert!(lo > 0.0 && hi < 180.0);
+        }
+        // Degenerate: a repeated corner gives 0 angles, not 180.
+        let d = dihedral_angles(&[[0.0; 3], [0.0; 3], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+        assert!(d.iter().all(|v| v.is_finite()));
+        assert_eq!(d[0], 0.0);
+    }
+
+    #[test]
+    fn sampled_matches_direct_lattice_evaluation() {
+        let mut rng = StdRng::seed_from_u64(6);
+        let pts = lattice(SAMPLE_ORDER);
+        assert_eq!(pts.len(), 84);
+        for _ in 0..200 {
+            let x = random_curved(&mut rng, 0.2);
+            let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+            for p in &pts {
+                let v = tet10_det_jacobian(&x, *p);
+                lo = lo.min(v);
+                hi = hi.max(v);
+            }
+            let want = if hi > 0.0 { lo / hi } else { -1.0 };
+            let got = scaled_jacobian_sampled(&x);
+            assert!((got - want).abs() < 1e-12, "{got} vs {want}");
         }
     }
 
