@@ -11,10 +11,12 @@
 
 use serde::Serialize;
 
-use super::bezier::{is_straight, scaled_jacobian_certified, LinearJacobian};
+use super::bezier::{
+    is_straight, scaled_jacobian_certified, straight_scaled_jacobian, LinearJacobian,
+};
 use super::quadrature::CompensatedSum;
 use super::shape::TET10_EDGES;
-use super::vec3::{add, cross, det3, dot, norm, scale, sub, tet_det, P3};
+use super::vec3::{add, cross, det3, dot, norm, scale, sub, P3};
 
 /// The dihedral angle of the regular tetrahedron, acos(1/3) in degrees (70.5288°):
 /// theta_e of the equiangular skewness.
@@ -131,7 +133,7 @@ pub fn equiangular_skewness(angles: &[f64; 6]) -> f64 {
 /// largest is 0.
 pub fn scaled_jacobian_sampled(x: &[P3; 10]) -> f64 {
     if is_straight(x) {
-        return sign_ratio(tet_det(x[0], x[1], x[2], x[3]));
+        return straight_scaled_jacobian(x);
     }
     // Columns of dx/dxi are linear: walk the lattice adding constant steps (9 adds and
     // one 3x3 determinant per point).
@@ -173,19 +175,6 @@ pub fn scaled_jacobian_sampled(x: &[P3; 10]) -> f64 {
         -1.0
     } else {
         0.0
-    }
-}
-
-#[inline]
-fn sign_ratio(d: f64) -> f64 {
-    if d > 0.0 {
-        1.0
-    } else if d < 0.0 {
-        -1.0
-    } else if d == 0.0 {
-        0.0
-    } else {
-        f64::NAN
     }
 }
 
