@@ -599,11 +599,49 @@ mod tests {
         }
     }
 
+    /// Exactly rounded sum (Shewchuk's partials, as Python's math.fsum).
+    fn fsum(values: impl IntoIterator<Item = f64>) -> f64 {
+        let mut partials: Vec<f64> = Vec::new();
+        for mut x in values {
+            let mut i = 0;
+            for j in 0..partials.len() {
+                let mut y = partials[j];
+                if x.abs() < y.abs() {
+                    std::mem::swap(&mut x, &mut y);
+                }
+                let hi = x + y;
+                let lo = y - (hi - x);
+                if lo != 0.0 {
+                    partials[i] = lo;
+                    i += 1;
+                }
+                x = hi;
+            }
+            partials.truncate(i);
+            partials.push(x);
+        }
+        partials.iter().rev().fold(0.0, |a, b| a + b)
+    }
+
     #[test]
     fn enclosed_volume_is_translation_and_order_invariant() {
-        let (nodes, tris) = p2_sphere(5, [0.0; 3]); // 20480 triangles
+        let (nodes, tris) = p2_sphere(6, [0.0; 3]); // 81920 triangles
         let v0 = enclosed_volume(&nodes, &tris);
-        let (far, _) = p2_sphere(5, [1000.0, -2000.0, 500.0]);
+        // The compensated sum is the exactly rounded sum of the same contributions to
+        // within a few ulps.
+        let o = nodes[tris[0][0] as usize];
+        let exact = fsum(tris.iter().map(|t| {
+            let mut x = [[0.0; 3]; 6];
+            for k in 0..6 {
+                x[k] = sub(nodes[t[k] as usize], o);
+            }
+            tri6_volume_contribution(&x)
+        }));
+        assert!(
+            (v0 - exact).abs() <= 2.0 * f64::EPSILON * exact,
+            "{v0} vs {exact}"
+        );
+        let (far, _) = p2_sphere(6, [1000.0, -2000.0, 500.0]);
         let v1 = enclosed_volume(&far, &tris);
         // Translating rounds the nodes by ~1e-13: the volume moves by about that much.
         assert!((v0 - v1).abs() < 1e-11 * v0, "{v0} vs {v1}");
