@@ -6,6 +6,7 @@ use super::vec3::{tet_det, P3};
 use rand::rngs::StdRng;
 use rand::Rng;
 
+/// The (n+1)(n+2)(n+3)/6 points of the order-n lattice of the reference tet.
 pub fn lattice(n: usize) -> Vec<[f64; 3]> {
     let mut out = Vec::new();
     for i in 0..=n {
@@ -22,6 +23,7 @@ pub fn lattice(n: usize) -> Vec<[f64; 3]> {
     out
 }
 
+/// A uniformly random point of the reference tet.
 pub fn random_ref_point(rng: &mut StdRng) -> [f64; 3] {
     loop {
         let p: [f64; 3] = [rng.random(), rng.random(), rng.random()];
@@ -31,6 +33,7 @@ pub fn random_ref_point(rng: &mut StdRng) -> [f64; 3] {
     }
 }
 
+/// Corners of a random well-shaped positive tet (edge ~2.8, det > 0.5), near the origin.
 pub fn random_corners(rng: &mut StdRng) -> [P3; 4] {
     // A regular tet, randomly stretched, rotated (via random linear map close to
     // identity) and translated: well shaped, positive.
@@ -66,6 +69,8 @@ pub fn random_corners(rng: &mut StdRng) -> [P3; 4] {
     }
 }
 
+/// A random curved P2 tet: [`random_corners`] with mid nodes moved by up to `amp` per
+/// coordinate (amp > 0). Large amp gives invalid (tangled) elements.
 pub fn random_curved(rng: &mut StdRng, amp: f64) -> [P3; 10] {
     let mut x = straight_tet10(random_corners(rng));
     for p in x.iter_mut().skip(4) {
