@@ -13,8 +13,8 @@
 //! How the coefficients are computed (the most accurate route, no matrix inverse): each
 //! column dx/dxi_d of the Jacobian matrix is a *linear* polynomial; in barycentric
 //! coordinates l it is `sum_j c_d[j] l_j` ([`LinearJacobian`]). So
-//! det J(l) = sum_{i,j,k} l_i l_j l_k det[c_1[i], c_2[j], c_3[k]], and the Bernstein
-//! coefficient of multi-index `a` is the average of det[c_1[i], c_2[j], c_3[k]] over the
+//! `det J(l) = sum_{i,j,k} l_i l_j l_k det[c_1[i], c_2[j], c_3[k]]`, and the Bernstein
+//! coefficient of multi-index `a` is the average of `det[c_1[i], c_2[j], c_3[k]]` over the
 //! ordered triples (i, j, k) whose multiset is `a` (64 small determinants). On a sub-tet
 //! with barycentric vertices V_0..V_3 the columns are again linear, with coefficients
 //! c_d(V_k): the same formula gives the coefficients of the restriction, computed from the
