@@ -1,8 +1,13 @@
 //! Pure geometry, no topology: exact predicates, P2 shape functions, quadrature,
 //! Bernstein (Bézier) bounds of the P2 tetrahedron's Jacobian, and quality metrics.
 
+pub mod bezier;
 pub mod predicates;
+pub mod quadrature;
+pub mod quality;
 pub mod shape;
+#[cfg(test)]
+mod testutil;
 pub mod vec3;
 
 pub use vec3::P3;
