@@ -12,11 +12,12 @@
 mod grid;
 mod repair;
 pub mod size;
-mod tmp_quality;
 pub mod validity;
 
 use crate::geom::predicates::orient3d;
-use crate::geom::shape::{tet10_det_jacobian, tri6_normal, TET10_EDGES};
+use crate::geom::bezier::certify;
+use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
+use crate::geom::shape::{tri6_normal, TET10_EDGES};
 use crate::geom::vec3::*;
 use crate::options::Options;
 use crate::{Error, Result};
@@ -354,6 +355,14 @@ impl<'a> Mesher<'a> {
             centroid3(p[0], p[1], p[2])
         };
         let open = self.faces.iter().filter(|f| f.alive).count();
+        if let Some(path) = std::env::var_os("CURVETET_DUMP") {
+            use std::io::Write;
+            let mut w = std::fs::File::create(path).unwrap();
+            for f in self.faces.iter().filter(|f| f.alive) {
+                let p = f.v.map(|x| self.pts[x as usize]);
+                writeln!(w, "{} {} {} {:?} {:?} {:?} {}", f.v[0], f.v[1], f.v[2], p[0], p[1], p[2], f.btri).unwrap();
+            }
+        }
         Error::MeshingFailed {
             msg: format!(
                 "{why}: the front could not be closed near ({:.6}, {:.6}, {:.6}) at face with vertices {:?}; {open} front faces remain open",
@@ -459,11 +468,10 @@ impl<'a> Mesher<'a> {
         let mut cands = std::mem::take(&mut self.cands);
         cands.retain_mut(|cd| {
             let tp = [fp[0], fp[1], fp[2], cd.p];
-            let ang = tmp_quality::dihedral_angles(&tp);
-            let mn = ang.iter().cloned().fold(f64::MAX, f64::min);
-            let sk = tmp_quality::skewness(&ang);
-            cd.q = 1.0 - sk;
-            mn >= min_dih && sk <= max_skew
+            let (mn, mx) = dihedral_extremes(&tp);
+            let sk = skewness_from_extremes(mn, mx);
+            cd.q = if sk.is_nan() { -1.0 } else { 1.0 - sk };
+            level == 2 || (mn >= min_dih && sk <= max_skew)
         });
         // Order (Algorithm 2): best quality first; if the best is a new point, existing
         // vertices closer than h to the ideal point come first, nearest first.
@@ -614,24 +622,9 @@ fn face_size(p: &[P3; 3]) -> f64 {
         .max(dist2(p[2], p[0]))
 }
 
-/// TEMPORARY sampled check until geom::bezier lands.
+/// Certified positivity of a curved candidate's Jacobian (Bernstein bounds).
 fn curved_valid(x: &[P3; 10]) -> bool {
-    let n = 6;
-    for i in 0..=n {
-        for j in 0..=n - i {
-            for k in 0..=n - i - j {
-                let xi = [
-                    i as f64 / n as f64,
-                    j as f64 / n as f64,
-                    k as f64 / n as f64,
-                ];
-                if tet10_det_jacobian(x, xi) <= 0.0 {
-                    return false;
-                }
-            }
-        }
-    }
-    true
+    certify(x).is_valid()
 }
 
 /// Run the front on a checked surface's arrays.

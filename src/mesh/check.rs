@@ -8,7 +8,12 @@ use super::TetMesh;
 use crate::geom::predicates::orient3d;
 use crate::geom::shape::{TET10_EDGES, TRI6_EDGES};
 use crate::geom::vec3::{det3, sub, tet_det};
+use crate::geom::quadrature::CompensatedSum;
 use crate::{Error, Result};
+
+fn compensated_sum(xs: impl Iterator<Item = f64>) -> f64 {
+    xs.collect::<CompensatedSum>().value()
+}
 use std::collections::HashMap;
 
 /// Figures from a passed conformity check.
@@ -24,22 +29,6 @@ pub struct Conformity {
     pub volume_linear: f64,
     /// Volume enclosed by the flat boundary triangles.
     pub enclosed_linear: f64,
-}
-
-/// Neumaier-compensated sum: accurate to ~1 ulp of the result for our volume sums.
-pub fn compensated_sum(xs: impl Iterator<Item = f64>) -> f64 {
-    let mut s = 0.0f64;
-    let mut c = 0.0f64;
-    for x in xs {
-        let t = s + x;
-        if s.abs() >= x.abs() {
-            c += (s - t) + x;
-        } else {
-            c += (x - t) + s;
-        }
-        s = t;
-    }
-    s + c
 }
 
 fn bad(elements: Vec<usize>, msg: String) -> Error {
