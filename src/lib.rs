@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod geom;
+pub mod io;
 pub mod mesh;
 pub mod surface;
 

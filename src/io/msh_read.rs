@@ -1,0 +1,785 @@
+//! Gmsh .msh reader: versions 2.2 (2.0, 2.1) and 4.1, ASCII and binary.
+//!
+//! Hand-written: no maintained crate reads both versions in both encodings (mshio covers
+//! 4.1 only), and we want exact error locations and hard caps on hostile header counts.
+//! The whole file is in memory; numbers are parsed from the input slice with no
+//! allocation per number.
+
+use std::collections::HashMap;
+
+use super::cursor::{capped, show, Cursor};
+use super::msh_types::nodes_per_element;
+use super::order::{self, Convention};
+use super::RawMesh;
+use crate::error::Result;
+
+/// Element types curvetet keeps.
+const TRI3: i32 = 2;
+const TRI6: i32 = 9;
+const TET4: i32 = 4;
+const TET10: i32 = 11;
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Version {
+    V2,
+    V41,
+}
+
+/// Which list of the RawMesh a block of elements went to.
+#[derive(Clone, Copy)]
+enum Kind {
+    Tri3,
+    Tri6,
+    Tet4,
+    Tet10,
+}
+
+/// A run of elements from one (4.1) entity block whose tags are resolved at the end,
+/// once `$Entities` has been seen.
+struct Block {
+    kind: Kind,
+    start: usize,
+    end: usize,
+    dim: i32,
+    entity: i32,
+}
+
+/// Node tags (arbitrary, possibly sparse) to 0-based indices.
+enum NodeMap {
+    Dense(Vec<u32>),
+    Sparse(HashMap<u64, u32>),
+}
+
+impl NodeMap {
+    /// Build the map; `Err(tag)` names a tag given twice.
+    fn build(tags: &[u64]) -> std::result::Result<NodeMap, u64> {
+        let n = tags.len() as u64;
+        let max = tags.iter().copied().max().unwrap_or(0);
+        if max <= 2 * n + 1024 {
+            let mut v = vec![u32::MAX; max as usize + 1];
+            for (i, &t) in tags.iter().enumerate() {
+                let slot = &mut v[t as usize];
+                if *slot != u32::MAX {
+                    return Err(t);
+                }
+                *slot = i as u32;
+            }
+            Ok(NodeMap::Dense(v))
+        } else {
+            let mut m = HashMap::with_capacity(tags.len());
+            for (i, &t) in tags.iter().enumerate() {
+                if m.insert(t, i as u32).is_some() {
+                    return Err(t);
+                }
+            }
+            Ok(NodeMap::Sparse(m))
+        }
+    }
+
+    #[inline]
+    fn get(&self, tag: u64) -> Option<u32> {
+        match self {
+            NodeMap::Dense(v) => v.get(tag as usize).copied().filter(|&i| i != u32::MAX),
+            NodeMap::Sparse(m) => m.get(&tag).copied(),
+        }
+    }
+}
+
+struct Reader<'a> {
+    c: Cursor<'a>,
+    version: Version,
+    binary: bool,
+    /// Gmsh's `size_t` in binary 4.1 files (4 or 8 bytes).
+    dsize: usize,
+    mesh: RawMesh,
+    node_map: Option<NodeMap>,
+    seen_elements: bool,
+    blocks: Vec<Block>,
+    /// (dim, entity tag) -> the entity's physical tag, for entities with exactly one.
+    physical: HashMap<(i32, i32), i32>,
+}
+
+/// Read a .msh file held in `data`; `name` is used in error locations.
+pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
+    let data = data.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(data);
+    let mut c = Cursor::new(data, name);
+    let t = c.expect_token("$MeshFormat")?;
+    if t != b"$MeshFormat" {
+        return Err(c.err("not a Gmsh .msh file: expected '$MeshFormat'"));
+    }
+    let v = c.expect_token("format version")?;
+    let version = match v {
+        b"4.1" => Version::V41,
+        b"2.2" | b"2" | b"2.0" | b"2.1" => Version::V2,
+        b"4" | b"4.0" => {
+            return Err(
+                c.err("MSH 4.0 is not supported; convert it with 'gmsh FILE -0 -format msh41'")
+            )
+        }
+        _ => {
+            return Err(c.err(format!(
+                "unsupported MSH version '{}' (supported: 2.2, 4.1)",
+                show(v)
+            )))
+        }
+    };
+    let file_type = c.u64("file type")?;
+    let dsize = c.u64("data size")?;
+    if file_type > 1 {
+        return Err(c.err(format!("file type must be 0 or 1, found {file_type}")));
+    }
+    let binary = file_type == 1;
+    if binary {
+        let ok = match version {
+            Version::V41 => dsize == 4 || dsize == 8,
+            Version::V2 => dsize == 8,
+        };
+        if !ok {
+            return Err(c.err(format!("unsupported data size {dsize} in a binary file")));
+        }
+        c.set_binary(true);
+        c.rest_of_line();
+        let one = c.bytes(4, "the binary endianness check (int 1)")?;
+        if one == 1i32.to_le_bytes() {
+            c.set_swap(false);
+        } else if one == 1i32.to_be_bytes() {
+            c.set_swap(true);
+        } else {
+            return Err(c.err("bad endianness check: expected the int 1"));
+        }
+    }
+    c.expect_word("$EndMeshFormat")?;
+
+    let mut r = Reader {
+        c,
+        version,
+        binary,
+        dsize: dsize as usize,
+        mesh: RawMesh::default(),
+        node_map: None,
+        seen_elements: false,
+        blocks: Vec::new(),
+        physical: HashMap::new(),
+    };
+    r.sections()?;
+    r.finish()
+}
+
+impl<'a> Reader<'a> {
+    fn sections(&mut self) -> Result<()> {
+        while let Some(tok) = self.c.token() {
+            if self.binary
+                && self.version == Version::V41
+                && matches!(tok, b"$Nodes" | b"$Elements" | b"$Entities")
+            {
+                // Binary data starts on the line after the section name.
+                self.c.rest_of_line();
+            }
+            match tok {
+                b"$Nodes" => {
+                    if self.node_map.is_some() {
+                        return Err(self.c.err("a second $Nodes section is not supported"));
+                    }
+                    match (self.version, self.binary) {
+                        (Version::V41, false) => self.nodes41_ascii()?,
+                        (Version::V41, true) => self.nodes41_binary()?,
+                        (Version::V2, _) => self.nodes2()?,
+                    }
+                    self.c.expect_word("$EndNodes")?;
+                }
+                b"$Elements" => {
+                    if self.node_map.is_none() {
+                        return Err(self.c.err("$Elements before $Nodes"));
+                    }
+                    if self.seen_elements {
+                        return Err(self.c.err("a second $Elements section is not supported"));
+                    }
+                    self.seen_elements = true;
+                    match (self.version, self.binary) {
+                        (Version::V41, false) => self.elements41_ascii()?,
+                        (Version::V41, true) => self.elements41_binary()?,
+                        (Version::V2, false) => self.elements2_ascii()?,
+                        (Version::V2, true) => self.elements2_binary()?,
+                    }
+                    self.c.expect_word("$EndElements")?;
+                }
+                b"$Entities" if self.version == Version::V41 => {
+                    if self.binary {
+                        self.entities_binary()?
+                    } else {
+                        self.entities_ascii()?
+                    }
+                    self.c.expect_word("$EndEntities")?;
+                }
+                t if t.len() > 1 && t[0] == b'$' && !t.starts_with(b"$End") => {
+                    self.skip_section(&t[1..])?
+                }
+                t => {
+                    return Err(self.c.err(format!(
+                        "expected a section such as $Nodes, found '{}'",
+                        show(t)
+                    )))
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Skip an unknown (or unused, like `$PhysicalNames`) section to its `$End` line.
+    fn skip_section(&mut self, name: &[u8]) -> Result<()> {
+        let start = self.c.pos();
+        let mut pat = b"$End".to_vec();
+        pat.extend_from_slice(name);
+        let rest = &self.c.data()[start..];
+        match rest.windows(pat.len()).position(|w| w == pat.as_slice()) {
+            Some(k) => {
+                self.c.seek(start + k + pat.len());
+                Ok(())
+            }
+            None => Err(self.c.err(format!(
+                "section ${} has no matching $End{}",
+                show(name),
+                show(name)
+            ))),
+        }
+    }
+
+    fn finish(mut self) -> Result<RawMesh> {
+        if self.node_map.is_none() {
+            return Err(self.c.eof("a $Nodes section"));
+        }
+        if !self.seen_elements {
+            return Err(self.c.eof("an $Elements section"));
+        }
+        // Entity tags become physical tags where the entity has exactly one.
+        for b in &self.blocks {
+            let tag = self
+                .physical
+                .get(&(b.dim, b.entity))
+                .copied()
+                .unwrap_or(b.entity);
+            let tags = match b.kind {
+                Kind::Tri3 => &mut self.mesh.tri3_tags,
+                Kind::Tri6 => &mut self.mesh.tri6_tags,
+                Kind::Tet4 => &mut self.mesh.tet4_tags,
+                Kind::Tet10 => &mut self.mesh.tet10_tags,
+            };
+            tags[b.start..b.end].fill(tag);
+        }
+        Ok(self.mesh)
+    }
+
+    // ----- $Entities (4.1) -----
+
+    fn entities_ascii(&mut self) -> Result<()> {
+        let c = &mut self.c;
+        let max = c.remaining() as u64;
+        let counts = [
+            c.count("number of points", max)?,
+            c.count("number of curves", max)?,
+            c.count("number of surfaces", max)?,
+            c.count("number of volumes", max)?,
+        ];
+        for (dim, &n) in counts.iter().enumerate() {
+            for _ in 0..n {
+                let tag = c.i32("entity tag")?;
+                let nbox = if dim == 0 { 3 } else { 6 };
+                for _ in 0..nbox {
+                    c.f64("entity bounding box")?;
+                }
+                let nphys = c.count("number of physical tags", max)?;
+                let mut first = 0;
+                for k in 0..nphys {
+                    let p = c.i32("physical tag")?;
+                    if k == 0 {
+                        first = p;
+                    }
+                }
+                if nphys == 1 {
+                    self.physical.insert((dim as i32, tag), first);
+                }
+                if dim > 0 {
+                    let nb = c.count("number of bounding entities", max)?;
+                    for _ in 0..nb {
+                        c.i32("bounding entity tag")?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn entities_binary(&mut self) -> Result<()> {
+        let ds = self.dsize;
+        let c = &mut self.c;
+        let mut counts = [0u64; 4];
+        for n in counts.iter_mut() {
+            *n = c.bin_usize(ds, "entity count")?;
+        }
+        for (dim, &n) in counts.iter().enumerate() {
+            let nbox = if dim == 0 { 3 } else { 6 };
+            c.need(n, 4 + 8 * nbox + ds, "entities")?;
+            for _ in 0..n {
+                let tag = c.bin_i32("entity tag")?;
+                c.bytes(8 * nbox, "entity bounding box")?;
+                let nphys = c.bin_usize(ds, "number of physical tags")?;
+                c.need(nphys, 4, "physical tags")?;
+                let mut first = 0;
+                for k in 0..nphys {
+                    let p = c.bin_i32("physical tag")?;
+                    if k == 0 {
+                        first = p;
+                    }
+                }
+                if nphys == 1 {
+                    self.physical.insert((dim as i32, tag), first);
+                }
+                if dim > 0 {
+                    let nb = c.bin_usize(ds, "number of bounding entities")?;
+                    c.need(nb, 4, "bounding entity tags")?;
+                    c.bytes(4 * nb as usize, "bounding entity tags")?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    // ----- $Nodes -----
+
+    fn set_nodes(&mut self, tags: Vec<u64>, at: usize) -> Result<()> {
+        match NodeMap::build(&tags) {
+            Ok(m) => {
+                self.node_map = Some(m);
+                Ok(())
+            }
+            Err(t) => Err(self.c.err_at(at, format!("node tag {t} is defined twice"))),
+        }
+    }
+
+    fn nodes41_ascii(&mut self) -> Result<()> {
+        let at = self.c.pos();
+        let max = self.c.remaining() as u64;
+        let nblocks = self.c.count("number of node blocks", max)?;
+        let nnodes = self.c.count("number of nodes", u32::MAX as u64 - 1)?;
+        self.c.u64("minimum node tag")?;
+        self.c.u64("maximum node tag")?;
+        let cap = capped(nnodes, self.c.remaining(), 8);
+        let mut tags = Vec::with_capacity(cap);
+        self.mesh.nodes.reserve(cap);
+        for _ in 0..nblocks {
+            let dim = self.c.i32("entity dimension")?;
+            self.c.i32("entity tag")?;
+            let param = self.c.i32("parametric flag")?;
+            let n = self.c.count("number of nodes in block", max)?;
+            if tags.len() as u64 + n > nnodes {
+                return Err(self
+                    .c
+                    .err("node blocks hold more nodes than the header says"));
+            }
+            let extra = if param != 0 {
+                dim.clamp(0, 3) as usize
+            } else {
+                0
+            };
+            for _ in 0..n {
+                tags.push(self.c.u64("node tag")?);
+            }
+            for _ in 0..n {
+                let x = self.c.f64("x coordinate")?;
+                let y = self.c.f64("y coordinate")?;
+                let z = self.c.f64("z coordinate")?;
+                for _ in 0..extra {
+                    self.c.f64("parametric coordinate")?;
+                }
+                self.mesh.nodes.push([x, y, z]);
+            }
+        }
+        if tags.len() as u64 != nnodes {
+            return Err(self.c.err(format!(
+                "node blocks hold {} nodes but the header says {nnodes}",
+                tags.len()
+            )));
+        }
+        self.set_nodes(tags, at)
+    }
+
+    fn nodes41_binary(&mut self) -> Result<()> {
+        let at = self.c.pos();
+        let ds = self.dsize;
+        let c = &mut self.c;
+        let nblocks = c.bin_usize(ds, "number of node blocks")?;
+        let nnodes = c.bin_usize(ds, "number of nodes")?;
+        c.bin_usize(ds, "minimum node tag")?;
+        c.bin_usize(ds, "maximum node tag")?;
+        if nnodes >= u32::MAX as u64 {
+            return Err(c.err(format!("{nnodes} nodes is more than curvetet supports")));
+        }
+        c.need(nblocks, 12 + ds, "node blocks")?;
+        c.need(nnodes, ds + 24, "nodes")?;
+        let mut tags = Vec::with_capacity(nnodes as usize);
+        self.mesh.nodes.reserve(nnodes as usize);
+        for _ in 0..nblocks {
+            let dim = c.bin_i32("entity dimension")?;
+            c.bin_i32("entity tag")?;
+            let param = c.bin_i32("parametric flag")?;
+            let n = c.bin_usize(ds, "number of nodes in block")?;
+            if tags.len() as u64 + n > nnodes {
+                return Err(c.err("node blocks hold more nodes than the header says"));
+            }
+            let extra = if param != 0 {
+                dim.clamp(0, 3) as usize
+            } else {
+                0
+            };
+            c.need(n, ds + 24 + 8 * extra, "nodes")?;
+            for _ in 0..n {
+                tags.push(c.bin_usize(ds, "node tag")?);
+            }
+            for _ in 0..n {
+                let x = c.bin_f64("x coordinate")?;
+                let y = c.bin_f64("y coordinate")?;
+                let z = c.bin_f64("z coordinate")?;
+                c.bytes(8 * extra, "parametric coordinates")?;
+                self.mesh.nodes.push([x, y, z]);
+            }
+        }
+        if tags.len() as u64 != nnodes {
+            return Err(c.err(format!(
+                "node blocks hold {} nodes but the header says {nnodes}",
+                tags.len()
+            )));
+        }
+        self.set_nodes(tags, at)
+    }
+
+    fn nodes2(&mut self) -> Result<()> {
+        let at = self.c.pos();
+        let n = self.c.count("number of nodes", u32::MAX as u64 - 1)?;
+        let mut tags;
+        if self.binary {
+            self.c.rest_of_line();
+            let c = &mut self.c;
+            c.need(n, 28, "nodes")?;
+            tags = Vec::with_capacity(n as usize);
+            self.mesh.nodes.reserve(n as usize);
+            for _ in 0..n {
+                let t = c.bin_i32("node tag")?;
+                let t = u64::try_from(t).map_err(|_| c.err(format!("negative node tag {t}")))?;
+                tags.push(t);
+                let x = c.bin_f64("x coordinate")?;
+                let y = c.bin_f64("y coordinate")?;
+                let z = c.bin_f64("z coordinate")?;
+                self.mesh.nodes.push([x, y, z]);
+            }
+        } else {
+            let cap = capped(n, self.c.remaining(), 8);
+            tags = Vec::with_capacity(cap);
+            self.mesh.nodes.reserve(cap);
+            for _ in 0..n {
+                tags.push(self.c.u64("node tag")?);
+                let x = self.c.f64("x coordinate")?;
+                let y = self.c.f64("y coordinate")?;
+                let z = self.c.f64("z coordinate")?;
+                self.mesh.nodes.push([x, y, z]);
+            }
+        }
+        self.set_nodes(tags, at)
+    }
+
+    // ----- $Elements -----
+
+    /// Map node tags to indices for element `etag`.
+    #[inline]
+    fn map<const K: usize>(&self, raw: &[u64; K], etag: u64) -> Result<[u32; K]> {
+        let map = self.node_map.as_ref().expect("nodes read before elements");
+        let mut out = [0u32; K];
+        for (o, &t) in out.iter_mut().zip(raw) {
+            *o = map.get(t).ok_or_else(|| {
+                self.c.err(format!(
+                    "element {etag} refers to node {t}, which does not exist"
+                ))
+            })?;
+        }
+        Ok(out)
+    }
+
+    /// Store one element of a kept type with (provisional) tag `tag`.
+    #[inline]
+    fn push(&mut self, ty: i32, raw: &[u64], etag: u64, tag: i32) -> Result<()> {
+        match ty {
+            TRI3 => {
+                let v = self.map::<3>(raw.try_into().expect("3 nodes"), etag)?;
+                self.mesh.tri3.push(v);
+                self.mesh.tri3_tags.push(tag);
+            }
+            TRI6 => {
+                let v = self.map::<6>(raw.try_into().expect("6 nodes"), etag)?;
+                self.mesh.tri6.push(order::tri6_from(Convention::Gmsh, &v));
+                self.mesh.tri6_tags.push(tag);
+            }
+            TET4 => {
+                let v = self.map::<4>(raw.try_into().expect("4 nodes"), etag)?;
+                self.mesh.tet4.push(v);
+                self.mesh.tet4_tags.push(tag);
+            }
+            TET10 => {
+                let v = self.map::<10>(raw.try_into().expect("10 nodes"), etag)?;
+                self.mesh
+                    .tet10
+                    .push(order::tet10_from(Convention::Gmsh, &v));
+                self.mesh.tet10_tags.push(tag);
+            }
+            _ => self.mesh.ignored_elements += 1,
+        }
+        Ok(())
+    }
+
+    fn kind_len(&self, kind: Kind) -> usize {
+        match kind {
+            Kind::Tri3 => self.mesh.tri3.len(),
+            Kind::Tri6 => self.mesh.tri6.len(),
+            Kind::Tet4 => self.mesh.tet4.len(),
+            Kind::Tet10 => self.mesh.tet10.len(),
+        }
+    }
+
+    fn kind_of(ty: i32) -> Option<Kind> {
+        match ty {
+            TRI3 => Some(Kind::Tri3),
+            TRI6 => Some(Kind::Tri6),
+            TET4 => Some(Kind::Tet4),
+            TET10 => Some(Kind::Tet10),
+            _ => None,
+        }
+    }
+
+    fn reserve(&mut self, kind: Kind, n: usize) {
+        match kind {
+            Kind::Tri3 => (self.mesh.tri3.reserve(n), self.mesh.tri3_tags.reserve(n)),
+            Kind::Tri6 => (self.mesh.tri6.reserve(n), self.mesh.tri6_tags.reserve(n)),
+            Kind::Tet4 => (self.mesh.tet4.reserve(n), self.mesh.tet4_tags.reserve(n)),
+            Kind::Tet10 => (self.mesh.tet10.reserve(n), self.mesh.tet10_tags.reserve(n)),
+        };
+    }
+
+    fn element_type(&self, ty: i32) -> Result<usize> {
+        nodes_per_element(ty).ok_or_else(|| self.c.err(format!("unknown element type {ty}")))
+    }
+
+    fn elements41_ascii(&mut self) -> Result<()> {
+        let max = self.c.remaining() as u64;
+        let nblocks = self.c.count("number of element blocks", max)?;
+        let nelem = self.c.count("number of elements", max)?;
+        self.c.u64("minimum element tag")?;
+        self.c.u64("maximum element tag")?;
+        let mut total = 0u64;
+        let mut raw = [0u64; 128];
+        for _ in 0..nblocks {
+            let dim = self.c.i32("entity dimension")?;
+            let entity = self.c.i32("entity tag")?;
+            let ty = self.c.i32("element type")?;
+            let n = self.c.count("number of elements in block", max)?;
+            let k = self.element_type(ty)?;
+            total += n;
+            if total > nelem {
+                return Err(self
+                    .c
+                    .err("element blocks hold more elements than the header says"));
+            }
+            let kind = Self::kind_of(ty);
+            if let Some(kind) = kind {
+                self.reserve(kind, capped(n, self.c.remaining(), 2 * (k + 1)));
+            }
+            let start = kind.map(|k| self.kind_len(k));
+            for _ in 0..n {
+                let etag = self.c.u64("element tag")?;
+                if kind.is_some() {
+                    for r in raw.iter_mut().take(k) {
+                        *r = self.c.u64("node tag")?;
+                    }
+                    self.eol()?;
+                    self.push(ty, &raw[..k], etag, entity)?;
+                } else {
+                    for _ in 0..k {
+                        self.c.u64("node tag")?;
+                    }
+                    self.eol()?;
+                    self.mesh.ignored_elements += 1;
+                }
+            }
+            if let (Some(kind), Some(start)) = (kind, start) {
+                let end = self.kind_len(kind);
+                self.blocks.push(Block {
+                    kind,
+                    start,
+                    end,
+                    dim,
+                    entity,
+                });
+            }
+        }
+        if total != nelem {
+            return Err(self.c.err(format!(
+                "element blocks hold {total} elements but the header says {nelem}"
+            )));
+        }
+        Ok(())
+    }
+
+    fn elements41_binary(&mut self) -> Result<()> {
+        let ds = self.dsize;
+        let nblocks = self.c.bin_usize(ds, "number of element blocks")?;
+        let nelem = self.c.bin_usize(ds, "number of elements")?;
+        self.c.bin_usize(ds, "minimum element tag")?;
+        self.c.bin_usize(ds, "maximum element tag")?;
+        self.c.need(nblocks, 12 + ds, "element blocks")?;
+        self.c.need(nelem, 2 * ds, "elements")?;
+        let mut total = 0u64;
+        let mut raw = [0u64; 128];
+        for _ in 0..nblocks {
+            let dim = self.c.bin_i32("entity dimension")?;
+            let entity = self.c.bin_i32("entity tag")?;
+            let ty = self.c.bin_i32("element type")?;
+            let n = self.c.bin_usize(ds, "number of elements in block")?;
+            let k = self.element_type(ty)?;
+            self.c.need(n, (k + 1) * ds, "elements")?;
+            total += n;
+            if total > nelem {
+                return Err(self
+                    .c
+                    .err("element blocks hold more elements than the header says"));
+            }
+            let kind = Self::kind_of(ty);
+            if let Some(kind) = kind {
+                self.reserve(kind, n as usize);
+                let start = self.kind_len(kind);
+                for _ in 0..n {
+                    let etag = self.c.bin_usize(ds, "element tag")?;
+                    for r in raw.iter_mut().take(k) {
+                        *r = self.c.bin_usize(ds, "node tag")?;
+                    }
+                    self.push(ty, &raw[..k], etag, entity)?;
+                }
+                let end = self.kind_len(kind);
+                self.blocks.push(Block {
+                    kind,
+                    start,
+                    end,
+                    dim,
+                    entity,
+                });
+            } else {
+                self.c.bytes(n as usize * (k + 1) * ds, "elements")?;
+                self.mesh.ignored_elements += n;
+            }
+        }
+        if total != nelem {
+            return Err(self.c.err(format!(
+                "element blocks hold {total} elements but the header says {nelem}"
+            )));
+        }
+        Ok(())
+    }
+
+    /// 2.2 tag rule: the physical tag, else the elementary tag.
+    fn tag2(tags: &[i32]) -> i32 {
+        match tags {
+            [] => 0,
+            [p, ..] if *p != 0 => *p,
+            [_, e, ..] => *e,
+            [_] => 0,
+        }
+    }
+
+    fn elements2_ascii(&mut self) -> Result<()> {
+        let max = self.c.remaining() as u64;
+        let n = self.c.count("number of elements", max)?;
+        let mut raw = [0u64; 128];
+        let mut tags = Vec::new();
+        for _ in 0..n {
+            let etag = self.c.u64("element tag")?;
+            let ty = self.c.i32("element type")?;
+            let k = self.element_type(ty)?;
+            let ntags = self.c.count("number of tags", max)?;
+            tags.clear();
+            for _ in 0..ntags {
+                tags.push(self.c.i32("element tag value")?);
+            }
+            if Self::kind_of(ty).is_some() {
+                for r in raw.iter_mut().take(k) {
+                    *r = self.c.u64("node tag")?;
+                }
+                self.eol()?;
+                let tag = Self::tag2(&tags);
+                self.push(ty, &raw[..k], etag, tag)?;
+            } else {
+                for _ in 0..k {
+                    self.c.u64("node tag")?;
+                }
+                self.eol()?;
+                self.mesh.ignored_elements += 1;
+            }
+        }
+        Ok(())
+    }
+
+    fn elements2_binary(&mut self) -> Result<()> {
+        let n = self.c.u64("number of elements")?;
+        self.c.rest_of_line();
+        self.c.need(n, 12, "elements")?;
+        let mut raw = [0u64; 128];
+        let mut tags = Vec::new();
+        let mut done = 0u64;
+        while done < n {
+            let ty = self.c.bin_i32("element type")?;
+            let follow = self.c.bin_i32("number of elements following")?;
+            let ntags = self.c.bin_i32("number of tags")?;
+            let k = self.element_type(ty)?;
+            if follow <= 0 || ntags < 0 || done + follow as u64 > n {
+                return Err(self.c.err(format!(
+                    "bad element block header: {follow} elements with {ntags} tags"
+                )));
+            }
+            let (follow, ntags) = (follow as u64, ntags as usize);
+            self.c.need(follow, 4 * (1 + ntags + k), "elements")?;
+            if Self::kind_of(ty).is_none() {
+                let size = follow as usize * 4 * (1 + ntags + k);
+                self.c.bytes(size, "elements")?;
+                self.mesh.ignored_elements += follow;
+                done += follow;
+                continue;
+            }
+            for _ in 0..follow {
+                let etag = self.c.bin_i32("element tag")?;
+                tags.clear();
+                for _ in 0..ntags {
+                    tags.push(self.c.bin_i32("element tag value")?);
+                }
+                for r in raw.iter_mut().take(k) {
+                    // A negative tag is an unknown node: map it past every real tag.
+                    *r = u64::try_from(self.c.bin_i32("node tag")?).unwrap_or(u64::MAX);
+                }
+                let tag = Self::tag2(&tags);
+                self.push(ty, &raw[..k], etag as u64, tag)?;
+            }
+            done += follow;
+        }
+        Ok(())
+    }
+
+    /// In ASCII, an element ends its line: anything else means a miscounted element.
+    fn eol(&mut self) -> Result<()> {
+        let d = self.c.data();
+        let mut p = self.c.pos();
+        while p < d.len() && (d[p] == b' ' || d[p] == b'\t' || d[p] == b'\r') {
+            p += 1;
+        }
+        if p < d.len() && d[p] != b'\n' {
+            return Err(self
+                .c
+                .err_at(p, "unexpected extra data after the element's nodes"));
+        }
+        self.c.seek(p);
+        Ok(())
+    }
+}
