@@ -384,7 +384,7 @@ mod tests {
         }
         assert_eq!(c.err("m").to_string(), "f:4: m");
         c.set_binary(true);
-        assert_eq!(c.err("m").to_string(), "f: byte 9: m");
+        assert_eq!(c.err("m").to_string(), "f: byte 7: m");
         assert!(c.f64("z").is_err());
         assert!(c.f64("z").unwrap_err().to_string().contains("end of file"));
     }
