@@ -745,3 +745,195 @@ fn gmsh_medit_export_matches_our_medit_order() {
         }
     }
 }
+
+// ------------------------------------------------------------------ binary variants
+
+/// A binary MSH 4.1 file built by hand: big- or little-endian, `size_t` of 4 or 8
+/// bytes, one surface entity in physical group 9, sparse node tags, one 6-node triangle.
+fn msh41_binary(big_endian: bool, ds: usize) -> Vec<u8> {
+    let i32b = |v: i32| {
+        if big_endian {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        }
+    };
+    let f64b = |v: f64| {
+        if big_endian {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        }
+    };
+    let size = |v: u64| -> Vec<u8> {
+        let mut b = if ds == 4 {
+            (v as u32).to_le_bytes().to_vec()
+        } else {
+            v.to_le_bytes().to_vec()
+        };
+        if big_endian {
+            b.reverse();
+        }
+        b
+    };
+    let mut v = format!("$MeshFormat\n4.1 1 {ds}\n").into_bytes();
+    v.extend(i32b(1));
+    v.extend(b"\n$EndMeshFormat\n$Entities\n");
+    for n in [0, 0, 1, 0] {
+        v.extend(size(n));
+    }
+    v.extend(i32b(3));
+    for x in [0.0, 0.0, 0.0, 1.0, 1.0, 0.0] {
+        v.extend(f64b(x));
+    }
+    v.extend(size(1));
+    v.extend(i32b(9));
+    v.extend(size(0));
+    v.extend(b"\n$EndEntities\n$Nodes\n");
+    for n in [1, 6, 10, 60] {
+        v.extend(size(n));
+    }
+    v.extend(i32b(2));
+    v.extend(i32b(3));
+    v.extend(i32b(0));
+    v.extend(size(6));
+    for t in [60u64, 50, 40, 30, 20, 10] {
+        v.extend(size(t));
+    }
+    let pts = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.5, 0.0, 0.0],
+        [0.5, 0.5, 0.0],
+        [0.0, 0.5, 0.0],
+    ];
+    for p in pts {
+        for x in p {
+            v.extend(f64b(x));
+        }
+    }
+    v.extend(b"\n$EndNodes\n$Elements\n");
+    for n in [1, 1, 1, 1] {
+        v.extend(size(n));
+    }
+    v.extend(i32b(2));
+    v.extend(i32b(3));
+    v.extend(i32b(9));
+    v.extend(size(1));
+    v.extend(size(1));
+    for t in [60u64, 50, 40, 30, 20, 10] {
+        v.extend(size(t));
+    }
+    v.extend(b"\n$EndElements\n");
+    v
+}
+
+#[test]
+fn binary_msh_of_either_endianness_and_size_t() {
+    for be in [false, true] {
+        for ds in [4, 8] {
+            let b = msh41_binary(be, ds);
+            let m = read_bytes(&b, Format::Msh, "bin.msh").unwrap();
+            assert_eq!(m.tri6, vec![[0, 1, 2, 3, 4, 5]], "be={be} ds={ds}");
+            assert_eq!(m.tri6_tags, vec![9]);
+            assert_eq!(m.nodes[4], [0.5, 0.5, 0.0]);
+            assert_gmsh_order("binary 4.1", &m);
+        }
+    }
+    // MSH 2.2 binary, big-endian: 3 nodes, one 3-node triangle, physical 4.
+    let mut v = b"$MeshFormat\n2.2 1 8\n".to_vec();
+    v.extend(1i32.to_be_bytes());
+    v.extend(b"\n$EndMeshFormat\n$Nodes\n3\n");
+    for (t, p) in [
+        (7, [0.0, 0.0, 1.0]),
+        (8, [1.0, 0.0, 1.0]),
+        (9, [0.0, 1.0, 1.0]),
+    ] {
+        v.extend((t as i32).to_be_bytes());
+        for x in p {
+            v.extend((x as f64).to_be_bytes());
+        }
+    }
+    v.extend(b"\n$EndNodes\n$Elements\n1\n");
+    for x in [2i32, 1, 2, 1, 4, 5, 9, 8, 7] {
+        v.extend(x.to_be_bytes());
+    }
+    v.extend(b"\n$EndElements\n");
+    let m = read_bytes(&v, Format::Msh, "be22.msh").unwrap();
+    assert_eq!(m.tri3, vec![[2, 1, 0]]);
+    assert_eq!(m.tri3_tags, vec![4]);
+    assert_eq!(m.nodes[1], [1.0, 0.0, 1.0]);
+}
+
+#[test]
+fn vtu_binary_header_styles_and_byte_orders() {
+    use base64::Engine;
+    let b64 = |b: &[u8]| base64::engine::general_purpose::STANDARD.encode(b);
+    let pts: [f64; 18] = [
+        0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.5, 0.0, 0.0, 0.5, 0.5, 0.0, 0.0, 0.5, 0.0,
+    ];
+    for big in [false, true] {
+        for header64 in [false, true] {
+            for separate in [false, true] {
+                // Encode an array the way VTK (separate header) or meshio (one stream) does.
+                let enc = |data: Vec<u8>| -> String {
+                    let n = data.len() as u64;
+                    let mut h = if header64 {
+                        n.to_le_bytes().to_vec()
+                    } else {
+                        (n as u32).to_le_bytes().to_vec()
+                    };
+                    if big {
+                        h.reverse();
+                    }
+                    if separate {
+                        format!("{}{}", b64(&h), b64(&data))
+                    } else {
+                        h.extend(data);
+                        b64(&h)
+                    }
+                };
+                let f = |x: f64| {
+                    if big {
+                        x.to_be_bytes()
+                    } else {
+                        x.to_le_bytes()
+                    }
+                };
+                let i = |x: i32| {
+                    if big {
+                        x.to_be_bytes()
+                    } else {
+                        x.to_le_bytes()
+                    }
+                };
+                let points = enc(pts.iter().flat_map(|&x| f(x)).collect());
+                let conn = enc([0, 1, 2, 3, 4, 5].iter().flat_map(|&x| i(x)).collect());
+                let offs = enc(i(6).to_vec());
+                let types = enc(vec![22u8]);
+                let tags = enc(i(-12).to_vec());
+                let text = format!(
+                    r#"<VTKFile type="UnstructuredGrid" version="1.0" byte_order="{}" header_type="{}">
+<UnstructuredGrid><Piece NumberOfPoints="6" NumberOfCells="1">
+<Points><DataArray type="Float64" NumberOfComponents="3" format="binary">
+   {points}
+</DataArray></Points>
+<Cells><DataArray type="Int32" Name="connectivity" format="binary">{conn}</DataArray>
+<DataArray type="Int32" Name="offsets" format="binary">{offs}</DataArray>
+<DataArray type="UInt8" Name="types" format="binary">{types}</DataArray></Cells>
+<CellData><DataArray type="Int32" Name="tags" format="binary">{tags}</DataArray></CellData>
+</Piece></UnstructuredGrid></VTKFile>"#,
+                    if big { "BigEndian" } else { "LittleEndian" },
+                    if header64 { "UInt64" } else { "UInt32" },
+                );
+                let what = format!("big={big} header64={header64} separate={separate}");
+                let m = read_bytes(text.as_bytes(), Format::Vtu, "b.vtu")
+                    .unwrap_or_else(|e| panic!("{what}: {e}"));
+                assert_eq!(m.tri6, vec![[0, 1, 2, 3, 4, 5]], "{what}");
+                assert_eq!(m.tri6_tags, vec![-12], "{what}");
+                assert_eq!(m.nodes[4], [0.5, 0.5, 0.0], "{what}");
+            }
+        }
+    }
+}

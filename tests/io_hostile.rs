@@ -252,18 +252,29 @@ fn mutated_files_never_panic() {
         .into_iter()
         .filter(|f| f.2.len() < 20_000)
         .collect();
-    let specials: [&[u8]; 8] = [
+    let specials: [&[u8]; 14] = [
         b"9",
         b"-1",
         b"0",
         b"99999999999999999999",
+        b"18446744073709551615",
+        b"4294967295",
+        b"-9223372036854775808",
+        b"2147483648",
         b"nan",
         b"$",
         b" ",
         b"\n",
+        b"<",
+        b"\"",
     ];
+    // CURVETET_FUZZ_ITERS raises the count for a longer local run.
+    let iters: usize = std::env::var("CURVETET_FUZZ_ITERS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(600);
     for (what, f, b, _) in &files {
-        for i in 0..600 {
+        for i in 0..iters {
             let mut m = b.clone();
             for _ in 0..1 + rng.below(4) {
                 let at = rng.below(m.len());
@@ -338,6 +349,7 @@ fn huge_header_counts_are_errors_without_huge_allocations() {
         (Format::Medit, b"MeshVersionFormatted 2\nDimension 3\nVertices\n1\n0 0 0 0\nTetrahedraP2\n99999999999999999\n1 1 1 1 1 1 1 1 1 1 0\n".to_vec()),
         (Format::Medit, b"MeshVersionFormatted 2\nDimension 3\nVertices\n1\n0 0 0 0\nCorners\n99999999999999999\n1\n".to_vec()),
         (Format::Vtu, br#"<VTKFile type="UnstructuredGrid"><UnstructuredGrid><Piece NumberOfPoints="99999999999" NumberOfCells="99999999999"><Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">0 0 0</DataArray></Points></Piece></UnstructuredGrid></VTKFile>"#.to_vec()),
+        (Format::Vtu, br#"<VTKFile type="UnstructuredGrid"><UnstructuredGrid><Piece NumberOfPoints="18446744073709551615" NumberOfCells="18446744073709551615"></Piece></UnstructuredGrid></VTKFile>"#.to_vec()),
         (Format::Vtu, br#"<VTKFile type="UnstructuredGrid" header_type="UInt64"><UnstructuredGrid><Piece NumberOfPoints="1" NumberOfCells="0"><Points><DataArray type="Float64" NumberOfComponents="3" format="binary">/////////////w==AAAA</DataArray></Points></Piece></UnstructuredGrid></VTKFile>"#.to_vec()),
     ];
     for (i, (f, b)) in cases.iter().enumerate() {

@@ -137,9 +137,12 @@ fn array<W: Write>(
     body: impl FnOnce(&mut dyn Write, bool) -> io::Result<()>,
 ) -> io::Result<()> {
     if binary {
-        let mut enc = base64::write::EncoderWriter::new(&mut *w, &STANDARD);
-        enc.write_all(&(nbytes as u64).to_le_bytes())?;
-        body(&mut enc, true)?;
+        let enc = base64::write::EncoderWriter::new(&mut *w, &STANDARD);
+        // Values come 1 to 8 bytes at a time: buffer them for the encoder.
+        let mut buf = io::BufWriter::with_capacity(1 << 16, enc);
+        buf.write_all(&(nbytes as u64).to_le_bytes())?;
+        body(&mut buf, true)?;
+        let mut enc = buf.into_inner().map_err(|e| e.into_error())?;
         enc.finish()?;
         drop(enc);
         w.write_all(b"\n")
@@ -228,6 +231,8 @@ struct Array<'a> {
     /// Byte offset of the array's opening tag and of its content.
     at: usize,
     content_at: Option<usize>,
+    /// The content is a single slice of the file starting at `content_at`.
+    in_file: bool,
     content: Cow<'a, [u8]>,
 }
 
@@ -398,6 +403,7 @@ impl<'a> Vtu<'a> {
                 binary: false,
                 at,
                 content_at: None,
+                in_file: false,
                 content: Cow::Borrowed(b""),
             });
             return Ok(());
@@ -453,6 +459,7 @@ impl<'a> Vtu<'a> {
             binary: format.as_ref() == b"binary",
             at,
             content_at: None,
+            in_file: false,
             content: Cow::Borrowed(b""),
         });
         Ok(())
@@ -466,9 +473,17 @@ impl<'a> Vtu<'a> {
             return;
         }
         if a.content_at.is_none() {
-            a.content_at = Some(end.saturating_sub(t.len()));
+            // Where the text lies in the file, for error lines (borrowed text only).
+            let base = self.data.as_ptr() as usize;
+            let at = match &t {
+                Cow::Borrowed(s) => (s.as_ptr() as usize).checked_sub(base),
+                Cow::Owned(_) => None,
+            };
+            a.content_at = Some(at.filter(|&o| o <= self.data.len()).unwrap_or(end));
+            a.in_file = at.is_some_and(|o| o + t.len() <= self.data.len());
             a.content = t;
         } else {
+            a.in_file = false;
             a.content.to_mut().push(b' ');
             a.content.to_mut().extend_from_slice(&t);
         }
@@ -514,9 +529,10 @@ impl<'a> Vtu<'a> {
 
     fn decode_ascii(&self, a: &Array<'a>, at: usize) -> Result<Values> {
         // Parse in place when the content is a slice of the file, so errors get its line.
-        let (data, start) = match &a.content {
-            Cow::Borrowed(s) if a.content_at.is_some() => (&self.data[..at + s.len()], at),
-            c => (c.as_ref(), 0),
+        let (data, start) = if a.in_file {
+            (&self.data[..at + a.content.len()], at)
+        } else {
+            (a.content.as_ref(), 0)
         };
         let mut c = Cursor::new(data, self.name);
         c.seek(start);
@@ -551,19 +567,30 @@ impl<'a> Vtu<'a> {
     }
 
     fn decode_binary(&self, content: &[u8], ty: NumType, at: usize) -> Result<Values> {
-        let b64: Vec<u8> = content
-            .iter()
-            .copied()
-            .filter(|b| !b.is_ascii_whitespace())
-            .collect();
+        let trimmed = content.trim_ascii();
+        let b64: Cow<[u8]> = if trimmed.iter().any(|b| b.is_ascii_whitespace()) {
+            Cow::Owned(
+                trimmed
+                    .iter()
+                    .copied()
+                    .filter(|b| !b.is_ascii_whitespace())
+                    .collect(),
+            )
+        } else {
+            Cow::Borrowed(trimmed)
+        };
         let hsize: usize = if self.header64 { 8 } else { 4 };
         let hchars = hsize.div_ceil(3) * 4;
         if b64.len() < hchars {
             return Err(self.err(at, "binary data array shorter than its header"));
         }
         let bad = |e: base64::DecodeError| self.err(at, format!("invalid base64 data: {e}"));
-        // VTK may encode the header separately (padded) or in one stream with the data.
-        let (header, payload) = if b64[hchars - 1] == b'=' {
+        // VTK may encode the header separately (then it ends in exactly `pad` '='s: two
+        // for a 4-byte header, one for 8 bytes) or in one stream with the data.
+        let pad = (3 - hsize % 3) % 3;
+        let separate =
+            b64[hchars - pad..hchars].iter().all(|&b| b == b'=') && b64[hchars - pad - 1] != b'=';
+        let (header, payload) = if separate {
             let h = STANDARD.decode(&b64[..hchars]).map_err(bad)?;
             let p = STANDARD.decode(&b64[hchars..]).map_err(bad)?;
             (h, p)
@@ -659,7 +686,7 @@ impl<'a> Vtu<'a> {
             tags,
         } = p;
         let base = self.mesh.nodes.len() as u64;
-        if base + npoints >= u32::MAX as u64 {
+        if base.saturating_add(npoints) >= u32::MAX as u64 {
             return Err(self.err(piece_at, "too many points"));
         }
         match points {
