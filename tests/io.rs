@@ -665,6 +665,17 @@ fn gmsh_checks_what_we_write_without_warnings() {
             files.push((file, mesh_to_bytes(&mesh, format, &opts).unwrap(), 8));
         }
     }
+    // Tags that cannot be physical tags (entities without a physical group).
+    let mut odd = mesh.clone();
+    odd.boundary_tags = vec![0, 5, -3, 5, 0, 5];
+    for ver in [MshVersion::V41, MshVersion::V22] {
+        let opts = WriteOptions {
+            msh_version: ver,
+            ..Default::default()
+        };
+        let name = format!("odd_tags_{ver:?}.msh");
+        files.push((name, mesh_to_bytes(&odd, Format::Msh, &opts).unwrap(), 8));
+    }
     let sphere = io::read(&data("sphere_p2.msh")).unwrap();
     let tags: Vec<i32> = (0..sphere.tri6.len()).map(|i| 1 + (i as i32 % 3)).collect();
     for bin in [false, true] {
@@ -835,9 +846,10 @@ fn binary_msh_of_either_endianness_and_size_t() {
         for ds in [4, 8] {
             let b = msh41_binary(be, ds);
             let m = read_bytes(&b, Format::Msh, "bin.msh").unwrap();
-            assert_eq!(m.tri6, vec![[0, 1, 2, 3, 4, 5]], "be={be} ds={ds}");
+            // Nodes are numbered by ascending tag: tags 60..10 become indices 5..0.
+            assert_eq!(m.tri6, vec![[5, 4, 3, 2, 1, 0]], "be={be} ds={ds}");
             assert_eq!(m.tri6_tags, vec![9]);
-            assert_eq!(m.nodes[4], [0.5, 0.5, 0.0]);
+            assert_eq!(m.nodes[m.tri6[0][4] as usize], [0.5, 0.5, 0.0]);
             assert_gmsh_order("binary 4.1", &m);
         }
     }
@@ -933,6 +945,172 @@ fn vtu_binary_header_styles_and_byte_orders() {
                 assert_eq!(m.tri6, vec![[0, 1, 2, 3, 4, 5]], "{what}");
                 assert_eq!(m.tri6_tags, vec![-12], "{what}");
                 assert_eq!(m.nodes[4], [0.5, 0.5, 0.0], "{what}");
+            }
+        }
+    }
+}
+
+// ------------------------------------------------------------------ VTK itself
+
+const VTK_CHECK: &str = r#"
+import sys
+import numpy as np
+import vtk
+from vtk.util.numpy_support import vtk_to_numpy
+log = vtk.vtkStringOutputWindow()
+vtk.vtkOutputWindow.SetInstance(log)
+inputs, outdir = sys.argv[1].split(","), sys.argv[2]
+for path in inputs:
+    r = vtk.vtkXMLUnstructuredGridReader() if path.endswith(".vtu") else vtk.vtkUnstructuredGridReader()
+    r.SetFileName(path)
+    r.Update()
+    g = r.GetOutput()
+    P = vtk_to_numpy(g.GetPoints().GetData())
+    types = sorted(set(g.GetCellType(i) for i in range(g.GetNumberOfCells())))
+    assert types == [22, 24], (path, types)
+    assert g.GetCellData().GetArray("BoundaryTag") is not None, path
+    # VTK's own quadratic edges (end, end, mid) must match where our mid nodes are.
+    for i in range(g.GetNumberOfCells()):
+        c = g.GetCell(i)
+        ids = [c.GetPointId(k) for k in range(c.GetNumberOfPoints())]
+        for k in range(c.GetNumberOfEdges()):
+            e = c.GetEdge(k)
+            a, b, m = (e.GetPointId(j) for j in range(3))
+            d = np.linalg.norm(P[ids] - (P[a] + P[b]) / 2, axis=1)
+            assert ids[int(np.argmin(d))] == m, (path, i, k)
+# Files written by VTK, for our readers.
+r = vtk.vtkXMLUnstructuredGridReader()
+r.SetFileName(inputs[0])
+r.Update()
+for mode, name in [("ascii", "vtk_ascii.vtu"), ("binary", "vtk_binary.vtu")]:
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetInputData(r.GetOutput())
+    w.SetCompressorTypeToNone()
+    w.SetDataModeToAscii() if mode == "ascii" else w.SetDataModeToBinary()
+    w.SetFileName(outdir + "/" + name)
+    assert w.Write() == 1
+w = vtk.vtkUnstructuredGridWriter()
+w.SetInputData(r.GetOutput())
+w.SetFileName(outdir + "/vtk_legacy.vtk")
+assert w.Write() == 1
+assert log.GetOutput() == "", log.GetOutput()
+print("vtk ok")
+"#;
+
+#[test]
+fn vtk_reads_what_we_write_and_we_read_what_vtk_writes() {
+    let has_vtk = Command::new("python3")
+        .args(["-c", "import vtk"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false);
+    if !has_vtk {
+        println!("note: python3 with vtk not available; skipped (pip install vtk)");
+        return;
+    }
+    let mesh = curved_mesh();
+    let dir = out_dir("vtk");
+    let mut inputs = Vec::new();
+    for (file, format, opts) in variants() {
+        if matches!(format, Format::Vtu | Format::Vtk) {
+            let p = dir.join(&file);
+            io::write_mesh(&p, &mesh, &opts).unwrap();
+            inputs.push(p.display().to_string());
+        }
+    }
+    let out = Command::new("python3")
+        .args([
+            "-c",
+            VTK_CHECK,
+            &inputs.join(","),
+            &dir.display().to_string(),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "VTK check failed:\n{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for file in ["vtk_ascii.vtu", "vtk_binary.vtu"] {
+        let back = io::read(&dir.join(file)).unwrap();
+        assert_same_geometry(file, &mesh, &back, 0);
+    }
+    // VTK's legacy writer (5.1 layout) prints 11 significant digits.
+    let back = io::read(&dir.join("vtk_legacy.vtk")).unwrap();
+    assert_eq!(back.tet10, mesh.tets);
+    assert_eq!(back.tri6, mesh.boundary);
+    assert_eq!(back.tri6_tags, mesh.boundary_tags);
+    for (p, q) in mesh.nodes.iter().zip(&back.nodes) {
+        for d in 0..3 {
+            assert!((p[d] - q[d]).abs() < 1e-10, "{p:?} vs {q:?}");
+        }
+    }
+}
+
+const MESHIO_WRITE: &str = r#"
+import sys
+import meshio
+src, outdir = sys.argv[1], sys.argv[2]
+m = meshio.read(src)
+meshio.write(outdir + "/mio41.msh", m, file_format="gmsh", binary=False)
+meshio.write(outdir + "/mio41b.msh", m, file_format="gmsh", binary=True)
+meshio.write(outdir + "/mio22.msh", m, file_format="gmsh22", binary=False)
+meshio.write(outdir + "/mio22b.msh", m, file_format="gmsh22", binary=True)
+meshio.write(outdir + "/mio_b.vtu", m, binary=True, compression=None)
+meshio.write(outdir + "/mio_a.vtu", m, binary=False)
+meshio.write(outdir + "/mio_a.vtk", m, binary=False)
+"#;
+
+/// Files meshio writes (from a surface we wrote) read back as the same surface.
+#[test]
+fn we_read_what_meshio_writes() {
+    if !has_python_meshio() {
+        println!("note: python3 with meshio not available; skipped (pip install meshio)");
+        return;
+    }
+    let s = io::read(&data("sphere_p2.msh")).unwrap();
+    let tags: Vec<i32> = (0..s.tri6.len()).map(|i| 1 + (i as i32 / 100)).collect();
+    let dir = out_dir("from_meshio");
+    let src = dir.join("src.msh");
+    io::write_surface(&src, &s.nodes, &s.tri6, &tags, &WriteOptions::default()).unwrap();
+    let out = Command::new("python3")
+        .args(["-c", MESHIO_WRITE])
+        .arg(&src)
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "meshio failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for file in [
+        "mio41.msh",
+        "mio41b.msh",
+        "mio22.msh",
+        "mio22b.msh",
+        "mio_b.vtu",
+        "mio_a.vtu",
+        "mio_a.vtk",
+    ] {
+        let back = io::read(&dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!(back.tri6, s.tri6, "{file}");
+        assert_eq!(back.tri6_tags, tags, "{file}");
+        assert_eq!(back.nodes.len(), s.nodes.len(), "{file}");
+        // meshio's ASCII VTK writers print 12 significant digits; the rest is exact.
+        let tol = if file.starts_with("mio_a") {
+            1e-11
+        } else {
+            0.0
+        };
+        for (i, (p, q)) in s.nodes.iter().zip(&back.nodes).enumerate() {
+            for d in 0..3 {
+                assert!(
+                    (p[d] - q[d]).abs() <= tol,
+                    "{file}: node {i}: {p:?} vs {q:?}"
+                );
             }
         }
     }

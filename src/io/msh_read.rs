@@ -51,28 +51,23 @@ enum NodeMap {
 }
 
 impl NodeMap {
-    /// Build the map; `Err(tag)` names a tag given twice.
-    fn build(tags: &[u64]) -> std::result::Result<NodeMap, u64> {
+    /// Map sorted, distinct `tags` to their ranks 0, 1, 2...
+    fn from_sorted(tags: &[u64]) -> NodeMap {
         let n = tags.len() as u64;
-        let max = tags.iter().copied().max().unwrap_or(0);
+        let max = tags.last().copied().unwrap_or(0);
         if max <= 2 * n + 1024 {
             let mut v = vec![u32::MAX; max as usize + 1];
             for (i, &t) in tags.iter().enumerate() {
-                let slot = &mut v[t as usize];
-                if *slot != u32::MAX {
-                    return Err(t);
-                }
-                *slot = i as u32;
+                v[t as usize] = i as u32;
             }
-            Ok(NodeMap::Dense(v))
+            NodeMap::Dense(v)
         } else {
-            let mut m = HashMap::with_capacity(tags.len());
-            for (i, &t) in tags.iter().enumerate() {
-                if m.insert(t, i as u32).is_some() {
-                    return Err(t);
-                }
-            }
-            Ok(NodeMap::Sparse(m))
+            NodeMap::Sparse(
+                tags.iter()
+                    .enumerate()
+                    .map(|(i, &t)| (t, i as u32))
+                    .collect(),
+            )
         }
     }
 
@@ -346,14 +341,23 @@ impl<'a> Reader<'a> {
 
     // ----- $Nodes -----
 
-    fn set_nodes(&mut self, tags: Vec<u64>, at: usize) -> Result<()> {
-        match NodeMap::build(&tags) {
-            Ok(m) => {
-                self.node_map = Some(m);
-                Ok(())
+    /// Number the nodes by ascending tag (node tag `t` of a file tagged 1..N becomes
+    /// index `t - 1`), whatever order the blocks list them in.
+    fn set_nodes(&mut self, mut tags: Vec<u64>, at: usize) -> Result<()> {
+        if !tags.windows(2).all(|w| w[0] < w[1]) {
+            let mut order: Vec<u32> = (0..tags.len() as u32).collect();
+            order.sort_unstable_by_key(|&i| tags[i as usize]);
+            let nodes = &self.mesh.nodes;
+            self.mesh.nodes = order.iter().map(|&i| nodes[i as usize]).collect();
+            tags = order.iter().map(|&i| tags[i as usize]).collect();
+            if let Some(w) = tags.windows(2).find(|w| w[0] == w[1]) {
+                return Err(self
+                    .c
+                    .err_at(at, format!("node tag {} is defined twice", w[0])));
             }
-            Err(t) => Err(self.c.err_at(at, format!("node tag {t} is defined twice"))),
         }
+        self.node_map = Some(NodeMap::from_sorted(&tags));
+        Ok(())
     }
 
     fn nodes41_ascii(&mut self) -> Result<()> {

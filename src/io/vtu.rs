@@ -324,8 +324,13 @@ impl<'a> Vtu<'a> {
                     self.close(e.local_name().as_ref(), before)?;
                     path.pop();
                 }
-                Event::Text(t) => self.text(t.into_inner(), rd.buffer_position() as usize),
-                Event::CData(t) => self.text(t.into_inner(), rd.buffer_position() as usize),
+                // Only the DataArray's own text: VTK nests <InformationKey> elements in it.
+                Event::Text(t) if path.last().is_some_and(|p| p == b"DataArray") => {
+                    self.text(t.into_inner(), rd.buffer_position() as usize)
+                }
+                Event::CData(t) if path.last().is_some_and(|p| p == b"DataArray") => {
+                    self.text(t.into_inner(), rd.buffer_position() as usize)
+                }
                 Event::GeneralRef(_)
                     if self
                         .array
