@@ -1115,3 +1115,122 @@ fn we_read_what_meshio_writes() {
         }
     }
 }
+
+/// Files Gmsh writes: a P2 box meshed with parametric node coordinates (4.1 ASCII and
+/// binary), and conversions of a surface we wrote to 4.1 binary and 2.2 ASCII/binary.
+#[test]
+fn we_read_what_gmsh_writes() {
+    if !has_gmsh() {
+        println!("note: gmsh not available; skipped");
+        return;
+    }
+    let dir = out_dir("from_gmsh");
+    let geo = dir.join("box.geo");
+    std::fs::write(
+        &geo,
+        "SetFactory(\"OpenCASCADE\");\nBox(1) = {0, 0, 0, 1, 2, 0.5};\n\
+         Physical Surface(7) = {1, 2, 3};\nPhysical Surface(8) = {4, 5, 6};\n\
+         Physical Volume(3) = {1};\nMesh.MeshSizeMax = 0.4;\n",
+    )
+    .unwrap();
+    let gmsh = |args: &[&str], out: &Path| {
+        let o = Command::new("gmsh")
+            .args(args)
+            .arg("-o")
+            .arg(out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    let (a, b) = (dir.join("box.msh"), dir.join("box_bin.msh"));
+    let g = geo.to_str().unwrap();
+    gmsh(&[g, "-3", "-order", "2", "-parametric", "-save_all"], &a);
+    gmsh(
+        &[g, "-3", "-order", "2", "-parametric", "-save_all", "-bin"],
+        &b,
+    );
+    let ma = io::read(&a).unwrap();
+    let mb = io::read(&b).unwrap();
+    // The same mesh; Gmsh prints 16 significant digits in ASCII (not always exact).
+    assert_eq!(
+        (&ma.tet10, &ma.tri6, &ma.tri6_tags),
+        (&mb.tet10, &mb.tri6, &mb.tri6_tags)
+    );
+    assert_eq!(ma.ignored_elements, mb.ignored_elements);
+    for (p, q) in ma.nodes.iter().zip(&mb.nodes) {
+        assert!((0..3).all(|d| (p[d] - q[d]).abs() <= 1e-15 * p[d].abs().max(1.0)));
+    }
+    assert!(!ma.tet10.is_empty() && !ma.tri6.is_empty());
+    assert!(ma.ignored_elements > 0, "points and lines are counted");
+    assert!(ma.tet10_tags.iter().all(|&t| t == 3));
+    assert!(ma.tri6_tags.iter().all(|&t| t == 7 || t == 8));
+    let vol: f64 = ma
+        .tet10
+        .iter()
+        .map(|t| {
+            let [p, q, r, s] = [0, 1, 2, 3].map(|k| ma.nodes[t[k] as usize]);
+            let (u, v, w) = (
+                [q[0] - p[0], q[1] - p[1], q[2] - p[2]],
+                [r[0] - p[0], r[1] - p[1], r[2] - p[2]],
+                [s[0] - p[0], s[1] - p[1], s[2] - p[2]],
+            );
+            (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+                + u[2] * (v[0] * w[1] - v[1] * w[0]))
+                / 6.0
+        })
+        .sum();
+    assert!((vol - 1.0).abs() < 1e-12, "box volume {vol}");
+    assert_gmsh_order_straight(&ma);
+
+    // Conversions of a surface we wrote.
+    let s = io::read(&data("sphere_p2.msh")).unwrap();
+    let tags: Vec<i32> = (0..s.tri6.len()).map(|i| 1 + (i as i32 / 100)).collect();
+    let src = dir.join("src.msh");
+    io::write_surface(&src, &s.nodes, &s.tri6, &tags, &WriteOptions::default()).unwrap();
+    let src = src.to_str().unwrap();
+    for (name, args) in [
+        ("g41b.msh", vec![src, "-0", "-bin"]),
+        ("g22.msh", vec![src, "-0", "-format", "msh22"]),
+        ("g22b.msh", vec![src, "-0", "-format", "msh22", "-bin"]),
+    ] {
+        let out = dir.join(name);
+        gmsh(&args, &out);
+        let back = io::read(&out).unwrap();
+        // Gmsh may renumber the nodes (MSH 2.2 export does) and prints 16 significant
+        // digits in ASCII: compare each triangle's six points.
+        let tol = if name.ends_with("b.msh") { 0.0 } else { 1e-15 };
+        assert_eq!(back.tri6.len(), s.tri6.len(), "{name}");
+        for (i, (a, b)) in s.tri6.iter().zip(&back.tri6).enumerate() {
+            let (xa, xb) = (tri_xyz(&s.nodes, a), tri_xyz(&back.nodes, b));
+            for k in 0..6 {
+                assert!(
+                    (0..3).all(|d| (xa[k][d] - xb[k][d]).abs() <= tol),
+                    "{name}: triangle {i} node {k}: {:?} vs {:?}",
+                    xa[k],
+                    xb[k]
+                );
+            }
+        }
+        assert_eq!(back.tri6_tags, tags, "{name}");
+    }
+}
+
+/// Straight-sided P2 elements (a box meshed by Gmsh): every mid node is at the midpoint
+/// of its Gmsh edge, to rounding.
+fn assert_gmsh_order_straight(m: &RawMesh) {
+    let close = |a: [f64; 3], b: [f64; 3]| (0..3).all(|d| (a[d] - b[d]).abs() < 1e-12);
+    for t in &m.tet10 {
+        let x = tet_xyz(&m.nodes, t);
+        for (k, [a, b]) in curvetet::geom::shape::TET10_EDGES.iter().enumerate() {
+            let mid = std::array::from_fn(|d| 0.5 * (x[*a][d] + x[*b][d]));
+            assert!(close(x[4 + k], mid), "tet node {}", 4 + k);
+        }
+    }
+    for t in &m.tri6 {
+        let x = tri_xyz(&m.nodes, t);
+        for (k, [a, b]) in curvetet::geom::shape::TRI6_EDGES.iter().enumerate() {
+            let mid = std::array::from_fn(|d| 0.5 * (x[*a][d] + x[*b][d]));
+            assert!(close(x[3 + k], mid), "triangle node {}", 3 + k);
+        }
+    }
+}

@@ -52,6 +52,10 @@ pub const VOLUME_TAG: i32 = 1;
 
 /// Everything a mesh file can hold that curvetet uses. Node indices are 0-based into
 /// `nodes`; element nodes are in curvetet's (Gmsh) order whatever the file's format.
+///
+/// Nodes keep the file's numbering: in .msh files they are numbered by ascending node
+/// tag (tags 1..N become indices 0..N-1; sparse tags keep their order), in .vtu/.vtk
+/// and .mesh files they are in file order.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RawMesh {
     /// Node coordinates.
