@@ -858,13 +858,13 @@ fn binary_msh_of_either_endianness_and_size_t() {
     v.extend(1i32.to_be_bytes());
     v.extend(b"\n$EndMeshFormat\n$Nodes\n3\n");
     for (t, p) in [
-        (7, [0.0, 0.0, 1.0]),
+        (7i32, [0.0f64, 0.0, 1.0]),
         (8, [1.0, 0.0, 1.0]),
         (9, [0.0, 1.0, 1.0]),
     ] {
-        v.extend((t as i32).to_be_bytes());
+        v.extend(t.to_be_bytes());
         for x in p {
-            v.extend((x as f64).to_be_bytes());
+            v.extend(x.to_be_bytes());
         }
     }
     v.extend(b"\n$EndNodes\n$Elements\n1\n");

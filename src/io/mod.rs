@@ -46,6 +46,7 @@ mod text_out;
 mod vtk;
 mod vtk_cells;
 mod vtu;
+mod vtu_write;
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
 pub const VOLUME_TAG: i32 = 1;
@@ -259,7 +260,7 @@ fn write_view<W: Write>(
 ) -> std::io::Result<()> {
     match format {
         Format::Msh => msh_write::write(w, view, opts),
-        Format::Vtu => vtu::write(w, view, opts.binary),
+        Format::Vtu => vtu_write::write(w, view, opts.binary),
         Format::Vtk => vtk::write(w, view),
         Format::Medit => medit::write(w, view, opts.medit_linear),
     }
