@@ -1234,3 +1234,13 @@ fn assert_gmsh_order_straight(m: &RawMesh) {
         }
     }
 }
+
+#[test]
+fn empty_mesh_round_trips() {
+    let empty = TetMesh::default();
+    for (file, format, opts) in variants() {
+        let bytes = mesh_to_bytes(&empty, format, &opts).unwrap();
+        let back = read_bytes(&bytes, format, &file).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(back.nodes.is_empty() && back.tri6.is_empty() && back.tet10.is_empty());
+    }
+}
