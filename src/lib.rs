@@ -9,6 +9,7 @@
 pub mod error;
 pub mod front;
 pub mod geom;
+pub mod io;
 pub mod mesh;
 pub mod options;
 pub mod surface;

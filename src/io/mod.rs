@@ -1,0 +1,340 @@
+//! Mesh files in and out: Gmsh .msh (2.2 and 4.1, ASCII and binary), VTK .vtu (XML) and
+//! legacy .vtk, and medit .mesh.
+//!
+//! | format | read | write |
+//! |---|---|---|
+//! | `.msh` | 2.2 (also 2.0/2.1) and 4.1, ASCII and binary, either endianness | 4.1 (default) or 2.2, ASCII (default) or binary |
+//! | `.vtu` | ASCII and inline base64 `binary` arrays (UInt32/UInt64 header, uncompressed) | ASCII (default) or inline base64 binary |
+//! | `.vtk` | legacy ASCII `UNSTRUCTURED_GRID`, classic and 5.x `CELLS` layouts | legacy ASCII (version 4.2 layout) |
+//! | `.mesh` | ASCII medit (`Triangles`, `TrianglesP2`, `Tetrahedra`, `TetrahedraP2`) | ASCII medit, P2 (default) or linear |
+//!
+//! Readers keep 3- and 6-node triangles and 4- and 10-node tetrahedra, converted to
+//! curvetet's (Gmsh) node order through [`order`]; other elements are counted in
+//! [`RawMesh::ignored_elements`]. Malformed input gives [`Error::Parse`] with `file:LINE`
+//! (text) or `file: byte N` (binary); it never panics, and no header count makes a reader
+//! reserve more memory than the file's size justifies.
+//!
+//! What the writers put in a file:
+//! - `.msh`: one surface entity per distinct boundary tag, each in a physical group whose
+//!   tag is that boundary tag (so the tags read back unchanged), and one volume entity in
+//!   physical group [`VOLUME_TAG`]. A Gmsh physical tag must be positive: triangles with a
+//!   tag <= 0 are written on their own surface entity without a physical group, and read
+//!   back with that entity's tag (a fresh positive number).
+//! - `.vtu`/`.vtk`: one unstructured grid holding both the tetrahedra (type 24) and the
+//!   boundary triangles (type 22), with an Int32 cell array `BoundaryTag` that holds each
+//!   triangle's tag and 0 for the tetrahedra (ParaView and meshio read mixed cells; use a
+//!   Threshold on the cell type or the tag to see one or the other).
+//! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = tag, and
+//!   `TetrahedraP2` with reference [`VOLUME_TAG`], in the order established in [`order`];
+//!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
+//!   instead (for meshio, MMG, TetGen, which do not read the P2 sections).
+
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::error::{Error, Result, SurfaceDefect};
+use crate::geom::P3;
+use crate::mesh::TetMesh;
+
+mod cursor;
+mod medit;
+mod msh_read;
+mod msh_types;
+mod msh_write;
+pub mod order;
+mod text_out;
+mod vtk;
+mod vtk_cells;
+mod vtu;
+mod vtu_write;
+
+/// The physical (msh) and reference (medit) tag written for the tetrahedra.
+pub const VOLUME_TAG: i32 = 1;
+
+/// Everything a mesh file can hold that curvetet uses. Node indices are 0-based into
+/// `nodes`; element nodes are in curvetet's (Gmsh) order whatever the file's format.
+///
+/// Nodes keep the file's numbering: in .msh files they are numbered by ascending node
+/// tag (tags 1..N become indices 0..N-1; sparse tags keep their order), in .vtu/.vtk
+/// and .mesh files they are in file order.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RawMesh {
+    /// Node coordinates.
+    pub nodes: Vec<[f64; 3]>,
+    /// 3-node triangles.
+    pub tri3: Vec<[u32; 3]>,
+    /// One tag per 3-node triangle.
+    pub tri3_tags: Vec<i32>,
+    /// 6-node triangles, Gmsh order: corners, then mid nodes of (0,1), (1,2), (2,0).
+    pub tri6: Vec<[u32; 6]>,
+    /// One tag per 6-node triangle.
+    pub tri6_tags: Vec<i32>,
+    /// 4-node tetrahedra.
+    pub tet4: Vec<[u32; 4]>,
+    /// One tag per 4-node tetrahedron.
+    pub tet4_tags: Vec<i32>,
+    /// 10-node tetrahedra, Gmsh order: corners, then mid nodes of (0,1), (1,2), (2,0),
+    /// (3,0), (3,2), (3,1).
+    pub tet10: Vec<[u32; 10]>,
+    /// One tag per 10-node tetrahedron.
+    pub tet10_tags: Vec<i32>,
+    /// Elements of other kinds (points, lines, quads, ...) that were skipped.
+    pub ignored_elements: u64,
+}
+
+impl RawMesh {
+    /// The P2 mesh in it: nodes, 10-node tets and 6-node boundary triangles with tags.
+    ///
+    /// A file with only 3-node triangles is a linear surface:
+    /// `Error::InvalidSurface(LinearSurface)`; 4-node tets without 10-node ones likewise
+    /// cannot make a [`TetMesh`].
+    pub fn into_tet_mesh(self) -> Result<TetMesh> {
+        if self.tri6.is_empty() && !self.tri3.is_empty() {
+            return Err(Error::surface(
+                SurfaceDefect::LinearSurface,
+                format!(
+                    "the file has {} 3-node triangles and no 6-node ones",
+                    self.tri3.len()
+                ),
+            ));
+        }
+        if self.tet10.is_empty() && !self.tet4.is_empty() {
+            return Err(Error::InvalidArgument(format!(
+                "the file has {} 4-node tetrahedra and no 10-node ones",
+                self.tet4.len()
+            )));
+        }
+        Ok(TetMesh {
+            nodes: self.nodes,
+            tets: self.tet10,
+            boundary: self.tri6,
+            boundary_tags: self.tri6_tags,
+        })
+    }
+}
+
+/// A mesh file format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Format {
+    /// Gmsh `.msh`.
+    Msh,
+    /// VTK XML unstructured grid `.vtu`.
+    Vtu,
+    /// VTK legacy `.vtk`.
+    Vtk,
+    /// medit / Gamma mesh format `.mesh` (ASCII).
+    Medit,
+}
+
+impl Format {
+    /// The format of a path, from its extension (`.msh`, `.vtu`, `.vtk`, `.mesh`; any
+    /// case).
+    pub fn from_path(path: &Path) -> Result<Format> {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("msh") => Ok(Format::Msh),
+            Some("vtu") => Ok(Format::Vtu),
+            Some("vtk") => Ok(Format::Vtk),
+            Some("mesh") => Ok(Format::Medit),
+            _ => Err(Error::InvalidArgument(format!(
+                "{}: unknown mesh file extension (expected .msh, .vtu, .vtk or .mesh)",
+                path.display()
+            ))),
+        }
+    }
+
+    /// The usual file extension, without the dot.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Msh => "msh",
+            Format::Vtu => "vtu",
+            Format::Vtk => "vtk",
+            Format::Medit => "mesh",
+        }
+    }
+}
+
+/// Read a mesh file; the format comes from the extension.
+pub fn read(path: &Path) -> Result<RawMesh> {
+    let format = Format::from_path(path)?;
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    read_bytes(&bytes, format, &path.display().to_string())
+}
+
+/// Read a mesh held in memory; `name` is used in error locations. Never panics, whatever
+/// the bytes.
+pub fn read_bytes(bytes: &[u8], format: Format, name: &str) -> Result<RawMesh> {
+    let mesh = match format {
+        Format::Msh => msh_read::read(bytes, name)?,
+        Format::Vtu => vtu::read(bytes, name)?,
+        Format::Vtk => vtk::read(bytes, name)?,
+        Format::Medit => medit::read(bytes, name)?,
+    };
+    debug_assert!(indices_in_range(&mesh));
+    Ok(mesh)
+}
+
+fn indices_in_range(m: &RawMesh) -> bool {
+    let n = m.nodes.len() as u32;
+    let ok = |s: &[u32]| s.iter().all(|&i| i < n);
+    m.tri3.iter().all(|e| ok(e))
+        && m.tri6.iter().all(|e| ok(e))
+        && m.tet4.iter().all(|e| ok(e))
+        && m.tet10.iter().all(|e| ok(e))
+        && m.tri3.len() == m.tri3_tags.len()
+        && m.tri6.len() == m.tri6_tags.len()
+        && m.tet4.len() == m.tet4_tags.len()
+        && m.tet10.len() == m.tet10_tags.len()
+}
+
+/// Gmsh .msh file format version to write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum MshVersion {
+    /// MSH 4.1 (Gmsh's current format).
+    #[default]
+    V41,
+    /// MSH 2.2 (the legacy format many solvers still read).
+    V22,
+}
+
+/// How to write a mesh file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct WriteOptions {
+    /// Version of .msh files (default 4.1).
+    pub msh_version: MshVersion,
+    /// Binary encoding: .msh binary, or .vtu with inline base64 arrays. Not available for
+    /// .vtk and .mesh (an error). Default: ASCII.
+    pub binary: bool,
+    /// For .mesh only: write linear `Triangles` and `Tetrahedra` (corner nodes) instead of
+    /// `TrianglesP2` and `TetrahedraP2`, for tools that read only linear medit files.
+    pub medit_linear: bool,
+}
+
+/// What the writers see: a validated P2 mesh or surface.
+pub(crate) struct MeshView<'a> {
+    pub nodes: &'a [P3],
+    pub tri6: &'a [[u32; 6]],
+    pub tags: &'a [i32],
+    pub tet10: &'a [[u32; 10]],
+}
+
+impl MeshView<'_> {
+    fn validate(&self) -> Result<()> {
+        let n = self.nodes.len();
+        if n >= u32::MAX as usize {
+            return Err(Error::InvalidArgument(format!("{n} nodes is too many")));
+        }
+        if self.tags.len() != self.tri6.len() {
+            return Err(Error::InvalidArgument(format!(
+                "{} triangles but {} tags",
+                self.tri6.len(),
+                self.tags.len()
+            )));
+        }
+        for (i, t) in self.tri6.iter().enumerate() {
+            if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidArgument(format!(
+                    "triangle {i} refers to node {v}, but there are {n} nodes"
+                )));
+            }
+        }
+        for (i, t) in self.tet10.iter().enumerate() {
+            if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
+                return Err(Error::InvalidArgument(format!(
+                    "tetrahedron {i} refers to node {v}, but there are {n} nodes"
+                )));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn write_view<W: Write>(
+    w: &mut W,
+    format: Format,
+    view: &MeshView,
+    opts: &WriteOptions,
+) -> std::io::Result<()> {
+    match format {
+        Format::Msh => msh_write::write(w, view, opts),
+        Format::Vtu => vtu_write::write(w, view, opts.binary),
+        Format::Vtk => vtk::write(w, view),
+        Format::Medit => medit::write(w, view, opts.medit_linear),
+    }
+}
+
+fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result<()> {
+    if opts.binary && matches!(format, Format::Vtk | Format::Medit) {
+        return Err(Error::InvalidArgument(format!(
+            "binary output is not available for .{} files",
+            format.extension()
+        )));
+    }
+    let biggest = view.nodes.len().max(view.tri6.len() + view.tet10.len());
+    if format == Format::Msh && opts.msh_version == MshVersion::V22 && biggest >= i32::MAX as usize
+    {
+        return Err(Error::InvalidArgument(
+            "too many nodes or elements for MSH 2.2 (32-bit tags); write MSH 4.1".into(),
+        ));
+    }
+    Ok(())
+}
+
+fn write_file(path: &Path, view: &MeshView, opts: &WriteOptions) -> Result<()> {
+    let format = Format::from_path(path)?;
+    check_options(format, opts, view)?;
+    view.validate()?;
+    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
+    let mut w = BufWriter::with_capacity(1 << 20, file);
+    write_view(&mut w, format, view, opts).map_err(|e| Error::io(path, e))?;
+    w.flush().map_err(|e| Error::io(path, e))?;
+    Ok(())
+}
+
+/// Write a P2 tetrahedral mesh and its boundary triangles; the format comes from the
+/// extension.
+pub fn write_mesh(path: &Path, mesh: &TetMesh, opts: &WriteOptions) -> Result<()> {
+    let view = MeshView {
+        nodes: &mesh.nodes,
+        tri6: &mesh.boundary,
+        tags: &mesh.boundary_tags,
+        tet10: &mesh.tets,
+    };
+    write_file(path, &view, opts)
+}
+
+/// Write a P2 surface (6-node triangles with one tag each), to `.msh`, `.vtu`, `.vtk` or
+/// `.mesh`.
+pub fn write_surface(
+    path: &Path,
+    nodes: &[[f64; 3]],
+    tri6: &[[u32; 6]],
+    tags: &[i32],
+    opts: &WriteOptions,
+) -> Result<()> {
+    let view = MeshView {
+        nodes,
+        tri6,
+        tags,
+        tet10: &[],
+    };
+    write_file(path, &view, opts)
+}
+
+/// The bytes [`write_mesh`] would write for `format` (for tests, pipes and fuzzing).
+pub fn mesh_to_bytes(mesh: &TetMesh, format: Format, opts: &WriteOptions) -> Result<Vec<u8>> {
+    let view = MeshView {
+        nodes: &mesh.nodes,
+        tri6: &mesh.boundary,
+        tags: &mesh.boundary_tags,
+        tet10: &mesh.tets,
+    };
+    check_options(format, opts, &view)?;
+    view.validate()?;
+    let mut out = Vec::new();
+    write_view(&mut out, format, &view, opts).expect("writing to memory cannot fail");
+    Ok(out)
+}

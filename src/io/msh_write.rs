@@ -1,0 +1,390 @@
+//! Gmsh .msh writer: 4.1 or 2.2, ASCII or binary (little-endian, `size_t` = 8 bytes).
+//!
+//! Layout (see `io` module docs): one surface entity per distinct boundary tag, in a
+//! physical group of that tag when it is positive; one volume entity in physical group
+//! `VOLUME_TAG`. Node and element order are kept: node `i` has tag `i + 1`, and 4.1
+//! element blocks follow runs of equal tags in the triangle list, so a file read back
+//! gives the same indices.
+
+use std::collections::BTreeMap;
+use std::io::{self, Write};
+
+use super::order::{self, Convention};
+use super::text_out::{float, int, point, uint};
+use super::{MeshView, MshVersion, WriteOptions, VOLUME_TAG};
+
+const TRI6: i32 = 9;
+const TET10: i32 = 11;
+/// The volume's entity tag.
+const VOLUME_ENTITY: i32 = 1;
+
+/// Surface entities: boundary tag -> (entity tag, physical tag if any).
+struct Entities {
+    surfaces: BTreeMap<i32, (i32, Option<i32>)>,
+    /// Each triangle's entity tag.
+    tri_entity: Vec<i32>,
+    has_volume: bool,
+}
+
+impl Entities {
+    fn new(view: &MeshView) -> Entities {
+        let mut surfaces = BTreeMap::new();
+        for &t in view.tags {
+            surfaces.entry(t).or_insert((0, None));
+        }
+        let max_pos = surfaces
+            .keys()
+            .copied()
+            .filter(|&t| t > 0)
+            .max()
+            .unwrap_or(0);
+        let mut fresh = max_pos;
+        for (&t, v) in surfaces.iter_mut() {
+            *v = if t > 0 {
+                (t, Some(t))
+            } else {
+                fresh += 1;
+                (fresh, None)
+            };
+        }
+        let tri_entity = view.tags.iter().map(|t| surfaces[t].0).collect();
+        Entities {
+            surfaces,
+            tri_entity,
+            has_volume: !view.tet10.is_empty() || view.tri6.is_empty(),
+        }
+    }
+
+    /// Each node's entity (dim, tag): the first triangle using it, else the volume (or,
+    /// without a volume, the first surface).
+    fn node_entities(&self, view: &MeshView) -> Vec<(i32, i32)> {
+        let fallback = if self.has_volume {
+            (3, VOLUME_ENTITY)
+        } else {
+            (2, self.tri_entity[0])
+        };
+        let mut e = vec![(0, 0); view.nodes.len()];
+        for (t, &ent) in view.tri6.iter().zip(&self.tri_entity) {
+            for &v in t {
+                if e[v as usize].0 == 0 {
+                    e[v as usize] = (2, ent);
+                }
+            }
+        }
+        for x in e.iter_mut() {
+            if x.0 == 0 {
+                *x = fallback;
+            }
+        }
+        e
+    }
+
+    /// Bounding boxes of the surface entities (by entity tag) and of the volume.
+    fn bboxes(&self, view: &MeshView) -> (BTreeMap<i32, [f64; 6]>, [f64; 6]) {
+        const EMPTY: [f64; 6] = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::INFINITY,
+            -f64::INFINITY,
+            -f64::INFINITY,
+            -f64::INFINITY,
+        ];
+        fn grow(b: &mut [f64; 6], p: &[f64; 3]) {
+            for d in 0..3 {
+                b[d] = b[d].min(p[d]);
+                b[d + 3] = b[d + 3].max(p[d]);
+            }
+        }
+        fn finish(b: &mut [f64; 6]) {
+            if b[0] > b[3] {
+                *b = [0.0; 6];
+            }
+        }
+        let mut surf: BTreeMap<i32, [f64; 6]> = BTreeMap::new();
+        for (t, &e) in view.tri6.iter().zip(&self.tri_entity) {
+            let b = surf.entry(e).or_insert(EMPTY);
+            for &v in t {
+                grow(b, &view.nodes[v as usize]);
+            }
+        }
+        surf.values_mut().for_each(finish);
+        let mut vol = EMPTY;
+        for t in view.tet10 {
+            for &v in t {
+                grow(&mut vol, &view.nodes[v as usize]);
+            }
+        }
+        finish(&mut vol);
+        (surf, vol)
+    }
+}
+
+/// Runs `[start, end)` of equal keys.
+fn runs<T: PartialEq + Copy>(keys: &[T]) -> Vec<(usize, usize, T)> {
+    let mut out = Vec::new();
+    let mut s = 0;
+    for i in 1..=keys.len() {
+        if i == keys.len() || keys[i] != keys[s] {
+            out.push((s, i, keys[s]));
+            s = i;
+        }
+    }
+    out
+}
+
+/// Write the mesh in the version and encoding `opts` asks for.
+pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView, opts: &WriteOptions) -> io::Result<()> {
+    let mut o = Out {
+        w,
+        binary: opts.binary,
+    };
+    match opts.msh_version {
+        MshVersion::V41 => write41(&mut o, view),
+        MshVersion::V22 => write22(&mut o, view),
+    }
+}
+
+/// A writer that puts values as text (space-separated) or as little-endian binary.
+struct Out<'w, W: Write> {
+    w: &'w mut W,
+    binary: bool,
+}
+
+impl<W: Write> Out<'_, W> {
+    fn raw(&mut self, s: &[u8]) -> io::Result<()> {
+        self.w.write_all(s)
+    }
+    /// A `size_t` (8 bytes) in binary, a number followed by `sep` in text.
+    fn size(&mut self, v: u64, sep: &[u8]) -> io::Result<()> {
+        if self.binary {
+            self.w.write_all(&v.to_le_bytes())
+        } else {
+            uint(self.w, v)?;
+            self.w.write_all(sep)
+        }
+    }
+    /// An `int` (4 bytes) in binary.
+    fn int(&mut self, v: i32, sep: &[u8]) -> io::Result<()> {
+        if self.binary {
+            self.w.write_all(&v.to_le_bytes())
+        } else {
+            int(self.w, v as i64)?;
+            self.w.write_all(sep)
+        }
+    }
+    fn double(&mut self, v: f64, sep: &[u8]) -> io::Result<()> {
+        if self.binary {
+            self.w.write_all(&v.to_le_bytes())
+        } else {
+            float(self.w, v)?;
+            self.w.write_all(sep)
+        }
+    }
+    fn header(&mut self, version: &str) -> io::Result<()> {
+        self.raw(b"$MeshFormat\n")?;
+        self.raw(version.as_bytes())?;
+        if self.binary {
+            self.raw(b" 1 8\n")?;
+            self.raw(&1i32.to_le_bytes())?;
+            self.raw(b"\n")?;
+        } else {
+            self.raw(b" 0 8\n")?;
+        }
+        self.raw(b"$EndMeshFormat\n")
+    }
+    /// End a binary data run before the `$End...` line.
+    fn end_data(&mut self) -> io::Result<()> {
+        if self.binary {
+            self.raw(b"\n")?;
+        }
+        Ok(())
+    }
+}
+
+fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
+    let ents = Entities::new(view);
+    o.header("4.1")?;
+
+    // $Entities
+    o.raw(b"$Entities\n")?;
+    o.size(0, b" ")?;
+    o.size(0, b" ")?;
+    o.size(ents.surfaces.len() as u64, b" ")?;
+    o.size(ents.has_volume as u64, b"\n")?;
+    let (surf_box, vol_box) = ents.bboxes(view);
+    for &(etag, phys) in ents.surfaces.values() {
+        let b = surf_box.get(&etag).copied().unwrap_or([0.0; 6]);
+        o.int(etag, b" ")?;
+        for x in b {
+            o.double(x, b" ")?;
+        }
+        match phys {
+            Some(p) => {
+                o.size(1, b" ")?;
+                o.int(p, b" ")?;
+            }
+            None => o.size(0, b" ")?,
+        }
+        o.size(0, b"\n")?;
+    }
+    if ents.has_volume {
+        o.int(VOLUME_ENTITY, b" ")?;
+        for x in vol_box {
+            o.double(x, b" ")?;
+        }
+        o.size(1, b" ")?;
+        o.int(VOLUME_TAG, b" ")?;
+        o.size(ents.surfaces.len() as u64, b"")?;
+        for &(etag, _) in ents.surfaces.values() {
+            if !o.binary {
+                o.raw(b" ")?;
+            }
+            o.int(etag, b"")?;
+        }
+        if !o.binary {
+            o.raw(b"\n")?;
+        }
+    }
+    o.end_data()?;
+    o.raw(b"$EndEntities\n")?;
+
+    // $Nodes: one block per run of nodes on the same entity, in index order.
+    let node_ent = ents.node_entities(view);
+    let node_runs = runs(&node_ent);
+    let n = view.nodes.len() as u64;
+    o.raw(b"$Nodes\n")?;
+    o.size(node_runs.len() as u64, b" ")?;
+    o.size(n, b" ")?;
+    o.size(n.min(1), b" ")?;
+    o.size(n, b"\n")?;
+    for &(s, e, (dim, etag)) in &node_runs {
+        o.int(dim, b" ")?;
+        o.int(etag, b" ")?;
+        o.int(0, b" ")?;
+        o.size((e - s) as u64, b"\n")?;
+        for i in s..e {
+            o.size(i as u64 + 1, b"\n")?;
+        }
+        for p in &view.nodes[s..e] {
+            if o.binary {
+                for x in p {
+                    o.double(*x, b"")?;
+                }
+            } else {
+                point(o.w, p)?;
+                o.raw(b"\n")?;
+            }
+        }
+    }
+    o.end_data()?;
+    o.raw(b"$EndNodes\n")?;
+
+    // $Elements: triangle blocks per run of equal entity, then the tets.
+    let tri_runs = runs(&ents.tri_entity);
+    let nblocks = tri_runs.len() + usize::from(!view.tet10.is_empty());
+    let m = (view.tri6.len() + view.tet10.len()) as u64;
+    o.raw(b"$Elements\n")?;
+    o.size(nblocks as u64, b" ")?;
+    o.size(m, b" ")?;
+    o.size(m.min(1), b" ")?;
+    o.size(m, b"\n")?;
+    let mut tag = 1u64;
+    for &(s, e, etag) in &tri_runs {
+        o.int(2, b" ")?;
+        o.int(etag, b" ")?;
+        o.int(TRI6, b" ")?;
+        o.size((e - s) as u64, b"\n")?;
+        for t in &view.tri6[s..e] {
+            o.size(tag, b" ")?;
+            tag += 1;
+            let t = order::tri6_to(Convention::Gmsh, t);
+            for (k, &v) in t.iter().enumerate() {
+                o.size(v as u64 + 1, if k == 5 { b"\n" } else { b" " })?;
+            }
+        }
+    }
+    if !view.tet10.is_empty() {
+        o.int(3, b" ")?;
+        o.int(VOLUME_ENTITY, b" ")?;
+        o.int(TET10, b" ")?;
+        o.size(view.tet10.len() as u64, b"\n")?;
+        for t in view.tet10 {
+            o.size(tag, b" ")?;
+            tag += 1;
+            let t = order::tet10_to(Convention::Gmsh, t);
+            for (k, &v) in t.iter().enumerate() {
+                o.size(v as u64 + 1, if k == 9 { b"\n" } else { b" " })?;
+            }
+        }
+    }
+    o.end_data()?;
+    o.raw(b"$EndElements\n")
+}
+
+fn write22<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
+    let ents = Entities::new(view);
+    o.header("2.2")?;
+
+    let n = view.nodes.len();
+    o.raw(b"$Nodes\n")?;
+    uint(o.w, n as u64)?;
+    o.raw(b"\n")?;
+    for (i, p) in view.nodes.iter().enumerate() {
+        o.int(i as i32 + 1, b" ")?;
+        if o.binary {
+            for x in p {
+                o.double(*x, b"")?;
+            }
+        } else {
+            point(o.w, p)?;
+            o.raw(b"\n")?;
+        }
+    }
+    o.end_data()?;
+    o.raw(b"$EndNodes\n")?;
+
+    let m = view.tri6.len() + view.tet10.len();
+    o.raw(b"$Elements\n")?;
+    uint(o.w, m as u64)?;
+    o.raw(b"\n")?;
+    let mut id = 1i32;
+    if !view.tri6.is_empty() && o.binary {
+        o.int(TRI6, b"")?;
+        o.int(view.tri6.len() as i32, b"")?;
+        o.int(2, b"")?;
+    }
+    for ((t, &etag), &btag) in view.tri6.iter().zip(&ents.tri_entity).zip(view.tags) {
+        let phys = ents.surfaces[&btag].1;
+        o.int(id, b" ")?;
+        id += 1;
+        if !o.binary {
+            o.raw(b"9 2 ")?;
+        }
+        o.int(phys.unwrap_or(0), b" ")?;
+        o.int(etag, b" ")?;
+        let t = order::tri6_to(Convention::Gmsh, t);
+        for (k, &v) in t.iter().enumerate() {
+            o.int(v as i32 + 1, if k == 5 { b"\n" } else { b" " })?;
+        }
+    }
+    if !view.tet10.is_empty() && o.binary {
+        o.int(TET10, b"")?;
+        o.int(view.tet10.len() as i32, b"")?;
+        o.int(2, b"")?;
+    }
+    for t in view.tet10 {
+        o.int(id, b" ")?;
+        id += 1;
+        if !o.binary {
+            o.raw(b"11 2 ")?;
+        }
+        o.int(VOLUME_TAG, b" ")?;
+        o.int(VOLUME_ENTITY, b" ")?;
+        let t = order::tet10_to(Convention::Gmsh, t);
+        for (k, &v) in t.iter().enumerate() {
+            o.int(v as i32 + 1, if k == 9 { b"\n" } else { b" " })?;
+        }
+    }
+    o.end_data()?;
+    o.raw(b"$EndElements\n")
+}
