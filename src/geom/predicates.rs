@@ -79,7 +79,8 @@ pub fn projection_of(a: P3, b: P3, c: P3) -> Option<(Proj, i32)> {
     for (i, j) in [(0, 1), (1, 2), (2, 0)] {
         let pr = Proj { i, j };
         let v = robust::orient2d(pr.p(a), pr.p(b), pr.p(c));
-        if v != 0.0 && best.is_none_or(|b| v.abs() > b.2) {
+        // (`Option::is_none_or` needs Rust 1.82; the crate's MSRV is 1.81.)
+        if v != 0.0 && best.map_or(true, |b| v.abs() > b.2) {
             best = Some((pr, sign(v), v.abs()));
         }
     }

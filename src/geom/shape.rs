@@ -199,10 +199,10 @@ mod tests {
         let g = tri6_grad(0.2, 0.3);
         let s: [f64; 2] = g.iter().fold([0.0, 0.0], |a, x| [a[0] + x[0], a[1] + x[1]]);
         assert!(s[0].abs() < 1e-14 && s[1].abs() < 1e-14);
-        for k in 0..6 {
+        for (k, gk) in g.iter().enumerate() {
             finite_diff_ok(
                 |u, v, _| tri6_shape(u, v)[k],
-                [g[k][0], g[k][1], 0.0],
+                [gk[0], gk[1], 0.0],
                 [0.2, 0.3, 0.0],
             );
         }
@@ -228,8 +228,8 @@ mod tests {
         }
         let p = [0.15, 0.2, 0.3];
         let g = tet10_grad(p);
-        for k in 0..10 {
-            finite_diff_ok(|a, b, c| tet10_shape([a, b, c])[k], g[k], p);
+        for (k, gk) in g.iter().enumerate() {
+            finite_diff_ok(|a, b, c| tet10_shape([a, b, c])[k], *gk, p);
         }
     }
 
