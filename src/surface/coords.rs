@@ -11,6 +11,8 @@
 //! diagonal is below [`MIN_BOX_DIAGONAL`] is rejected as well: it is almost surely in the
 //! wrong unit, and metric tolerances relative to its size would underflow.
 
+use rayon::prelude::*;
+
 use super::describe;
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::P3;
@@ -84,16 +86,22 @@ pub fn check_coordinates(nodes: &[P3]) -> Result<()> {
 /// Two nodes with identical coordinates (0.0 and -0.0 are equal). Coordinates must be
 /// finite.
 pub fn check_duplicates(nodes: &[P3]) -> Result<()> {
-    let mut order: Vec<u32> = (0..nodes.len() as u32).collect();
-    let key = |i: &u32| nodes[*i as usize];
-    order.sort_unstable_by(|a, b| {
-        let (pa, pb) = (key(a), key(b));
-        pa[0]
-            .total_cmp_eq(pb[0])
-            .then(pa[1].total_cmp_eq(pb[1]))
-            .then(pa[2].total_cmp_eq(pb[2]))
-            .then(a.cmp(b))
-    });
+    // Sort by a key that orders finite f64 numerically, with -0.0 mapped to 0.0.
+    let key = |x: f64| {
+        let b = (x + 0.0).to_bits(); // -0.0 + 0.0 == +0.0
+        if b >> 63 == 1 {
+            !b
+        } else {
+            b | (1 << 63)
+        }
+    };
+    let mut order: Vec<([u64; 3], u32)> = nodes
+        .iter()
+        .enumerate()
+        .map(|(i, p)| (p.map(key), i as u32))
+        .collect();
+    order.par_sort_unstable();
+    let order: Vec<u32> = order.into_iter().map(|x| x.1).collect();
     let mut first: Option<(u32, u32)> = None;
     for w in order.windows(2) {
         let (a, b) = (w[0], w[1]);
@@ -114,17 +122,4 @@ pub fn check_duplicates(nodes: &[P3]) -> Result<()> {
         ));
     }
     Ok(())
-}
-
-/// Numeric order where -0.0 == 0.0 (values are finite).
-trait CmpEq {
-    fn total_cmp_eq(self, other: f64) -> std::cmp::Ordering;
-}
-
-impl CmpEq for f64 {
-    #[inline]
-    fn total_cmp_eq(self, other: f64) -> std::cmp::Ordering {
-        self.partial_cmp(&other)
-            .unwrap_or(std::cmp::Ordering::Equal)
-    }
 }

@@ -27,6 +27,8 @@ pub(crate) struct Grid {
     items: Vec<u32>,
     /// Non-empty cells, sorted by key: (key, start, end) into `items`.
     cells: Vec<(u64, u32, u32)>,
+    /// Per box, the cell indices of its min corner.
+    lo: Vec<[u32; 3]>,
 }
 
 /// Closed boxes overlap.
@@ -73,6 +75,7 @@ impl Grid {
             dims: [1; 3],
             items: Vec::new(),
             cells: Vec::new(),
+            lo: Vec::new(),
         };
         if boxes.is_empty() {
             return g;
@@ -122,8 +125,10 @@ impl Grid {
             h *= 2.0;
         }
         let mut reg: Vec<(u64, u32)> = Vec::new();
+        g.lo.reserve(boxes.len());
         for (id, b) in boxes.iter().enumerate() {
             let (l, u, _) = g.span(b);
+            g.lo.push(l.map(|x| x as u32));
             for iy in l[1]..=u[1] {
                 for iz in l[2]..=u[2] {
                     for ix in l[0]..=u[0] {
@@ -133,6 +138,7 @@ impl Grid {
             }
         }
         reg.par_sort_unstable();
+
         g.items = reg.iter().map(|r| r.1).collect();
         let mut i = 0;
         while i < reg.len() {
@@ -154,35 +160,40 @@ impl Grid {
         (l, u, n)
     }
 
-    /// Calls `conflict(i, j)` (i < j) once for every pair of overlapping boxes and returns
-    /// the smallest pair (lexicographic) for which it returned true. Runs in parallel;
-    /// the answer does not depend on the thread count.
-    pub fn min_conflict<F>(&self, boxes: &[Aabb], conflict: F) -> Option<(u32, u32)>
+    /// Visits every pair (i < j) of overlapping boxes exactly once, in parallel: each
+    /// worker folds its pairs into a state made by `init` with `visit`, and the states are
+    /// merged with `merge`. With an order-independent `merge` (e.g. a minimum) the result
+    /// does not depend on the thread count.
+    pub fn fold_pairs<T, I, V, M>(&self, boxes: &[Aabb], init: I, visit: V, merge: M) -> T
     where
-        F: Fn(u32, u32) -> bool + Sync,
+        T: Send,
+        I: Fn() -> T + Sync + Send,
+        V: Fn(&mut T, u32, u32) + Sync + Send,
+        M: Fn(T, T) -> T + Sync + Send,
     {
         self.cells
             .par_iter()
-            .filter_map(|&(key, s, e)| {
-                let cell = [key & 0x1f_ffff, key >> 42, (key >> 21) & 0x1f_ffff];
+            .fold(&init, |mut state, &(key, s, e)| {
+                let cell = [key & 0x1f_ffff, key >> 42, (key >> 21) & 0x1f_ffff].map(|x| x as u32);
                 let ids = &self.items[s as usize..e as usize];
-                // Pairs come in lexicographic order: the first conflict is the cell's least.
                 for (k, &a) in ids.iter().enumerate() {
                     let ba = &boxes[a as usize];
+                    let la = self.lo[a as usize];
                     for &b in &ids[k + 1..] {
-                        let bb = &boxes[b as usize];
-                        if !overlap(ba, bb) {
+                        if !overlap(ba, &boxes[b as usize]) {
                             continue;
                         }
-                        let home = (0..3).all(|d| self.idx(ba[0][d].max(bb[0][d]), d) == cell[d]);
-                        if home && conflict(a, b) {
-                            return Some((a, b));
+                        // Only in the cell of the intersection's min corner (idx is
+                        // monotone, so that cell is the max of the two min-corner cells).
+                        let lb = self.lo[b as usize];
+                        if (0..3).all(|d| la[d].max(lb[d]) == cell[d]) {
+                            visit(&mut state, a, b);
                         }
                     }
                 }
-                None
+                state
             })
-            .min()
+            .reduce(&init, merge)
     }
 
     /// Ids of the boxes that may meet the ray from `p` along +x: those registered in the

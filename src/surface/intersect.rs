@@ -1,14 +1,18 @@
 //! Exact self-intersection checks, broad phase by a uniform grid ([`super::grid`]), so the
 //! cost stays about O(n log n) for reasonable meshes.
 //!
-//! **Chord level** ([`check_chords`]): every pair of flat chord (corner) triangles whose
+//! Both levels run in one pass ([`check_intersections`]) over the pairs of curved
+//! triangles whose six-node bounding boxes overlap; a chord-level conflict anywhere is
+//! reported before any curved-level one.
+//!
+//! **Chord level**: every pair of flat chord (corner) triangles whose
 //! bounding boxes overlap is tested with the exact `triangle_triangle_conflict`: meeting
 //! at shared vertices or along a shared edge is fine, any other contact (touching,
 //! crossing, coplanar overlap) is a
 //! [`SelfIntersection`](SurfaceDefect::SelfIntersection), naming both triangles. Two
 //! triangles with the same three corners coincide and are reported too.
 //!
-//! **Curved level** ([`check_curved`]): each P2 triangle is split at its mid nodes into
+//! **Curved level**: each P2 triangle is split at its mid nodes into
 //! four flat sub-triangles (c0 m01 m20, m01 c1 m12, m20 m12 c2, m01 m12 m20) and every
 //! overlapping pair of sub-triangles (of the same or different triangles; shared nodes
 //! are judged by id) is tested the same way. A conflict there is also an **error**
@@ -24,8 +28,10 @@
 //! [`FoldedTriangle`](SurfaceDefect::FoldedTriangle) (such a split does not occur in a
 //! sensible curved triangle).
 
+use rayon::prelude::*;
+
 use super::describe;
-use super::grid::{bbox, Aabb, Grid};
+use super::grid::{bbox, overlap, Aabb, Grid};
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::predicates::{collinear, orient3d, triangle_triangle_conflict};
 use crate::geom::P3;
@@ -43,40 +49,125 @@ pub(crate) fn flat_conflict(nodes: &[P3], a: [u32; 3], b: [u32; 3]) -> bool {
     }
     let pa = a.map(|v| nodes[v as usize]);
     let pb = b.map(|v| nodes[v as usize]);
-    if shared == 0 {
-        // Exact early outs: one triangle strictly on one side of the other's plane.
-        let s = pb.map(|q| orient3d(pa[0], pa[1], pa[2], q));
-        if s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0) {
-            return false;
-        }
-        let s = pa.map(|q| orient3d(pb[0], pb[1], pb[2], q));
-        if s.iter().all(|&x| x > 0) || s.iter().all(|&x| x < 0) {
-            return false;
-        }
+    // Exact early out: if the vertices of one triangle that the other lacks lie strictly
+    // on one side of the other's plane, the first meets that plane only in the shared
+    // vertex or edge (or not at all), so the two meet only there. For a smooth surface
+    // this settles almost every pair with one to three orientation tests.
+    if strictly_one_side(pa, a, pb, b) || strictly_one_side(pb, b, pa, a) {
+        return false;
     }
     triangle_triangle_conflict(pa, a, pb, b)
+}
+
+/// Are the vertices of `q` whose ids are not in `pid` all strictly on one side of the
+/// plane of `p`?
+#[inline]
+fn strictly_one_side(p: [P3; 3], pid: [u32; 3], q: [P3; 3], qid: [u32; 3]) -> bool {
+    let mut side = 0;
+    for k in 0..3 {
+        if pid.contains(&qid[k]) {
+            continue;
+        }
+        let s = orient3d(p[0], p[1], p[2], q[k]);
+        if s == 0 || (side != 0 && s != side) {
+            return false;
+        }
+        side = s;
+    }
+    side != 0
 }
 
 fn corners(tri: &[u32; 6]) -> [u32; 3] {
     [tri[0], tri[1], tri[2]]
 }
 
-/// Chord triangles do not meet except at shared vertices and edges. Triangles must be
-/// non-degenerate.
-pub fn check_chords(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
+/// Node ids of sub-triangle `s` (= 4 * triangle + k).
+fn sub_ids(tris: &[[u32; 6]], s: u32) -> [u32; 3] {
+    let t = &tris[(s / 4) as usize];
+    SUB_TRIANGLES[(s % 4) as usize].map(|k| t[k])
+}
+
+fn pts(nodes: &[P3], ids: [u32; 3]) -> [P3; 3] {
+    ids.map(|v| nodes[v as usize])
+}
+
+/// The least conflicting pairs found so far: chord triangles, and sub-triangles.
+#[derive(Default, Clone, Copy)]
+struct Hits {
+    chord: Option<(u32, u32)>,
+    sub: Option<(u32, u32)>,
+}
+
+fn min_opt(a: Option<(u32, u32)>, b: Option<(u32, u32)>) -> Option<(u32, u32)> {
+    match (a, b) {
+        (Some(x), Some(y)) => Some(x.min(y)),
+        (x, None) => x,
+        (None, y) => y,
+    }
+}
+
+/// Both intersection checks of the module docs, in one pass over the pairs of curved
+/// triangles whose six-node bounding boxes overlap (they contain the chord triangle and
+/// the four sub-triangles). Reports, in this order: a chord-level conflict (the least
+/// pair of triangles), a degenerate sub-triangle, a sub-triangle conflict. Triangles
+/// must be non-degenerate.
+pub fn check_intersections(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
+    let n_sub = 4 * tris.len() as u32;
+    let degenerate: Vec<bool> = (0..n_sub)
+        .into_par_iter()
+        .map(|s| {
+            let [a, b, c] = pts(nodes, sub_ids(tris, s));
+            collinear(a, b, c)
+        })
+        .collect();
     let boxes: Vec<Aabb> = tris
-        .iter()
-        .map(|t| bbox(corners(t).map(|v| nodes[v as usize])))
+        .par_iter()
+        .map(|t| bbox(t.map(|v| nodes[v as usize])))
         .collect();
     let grid = Grid::build(&boxes);
-    let hit = grid.min_conflict(&boxes, |i, j| {
-        flat_conflict(
-            nodes,
-            corners(&tris[i as usize]),
-            corners(&tris[j as usize]),
-        )
-    });
-    if let Some((i, j)) = hit {
+    let visit = |h: &mut Hits, i: u32, j: u32| {
+        let (ti, tj) = (&tris[i as usize], &tris[j as usize]);
+        if h.chord.is_none_or_after((i, j)) {
+            let (ci, cj) = (corners(ti), corners(tj));
+            if overlap(&bbox(pts(nodes, ci)), &bbox(pts(nodes, cj))) && flat_conflict(nodes, ci, cj)
+            {
+                h.chord = Some((i, j));
+            }
+        }
+        if h.chord.is_some() {
+            return; // a chord conflict anywhere is reported before any curved one
+        }
+        let sub_boxes = |t: u32| {
+            let x = tris[t as usize].map(|v| nodes[v as usize]);
+            SUB_TRIANGLES.map(|k| bbox(k.map(|q| x[q])))
+        };
+        let (bi, bj) = (sub_boxes(i), sub_boxes(j));
+        for ki in 0..4u32 {
+            let si = 4 * i + ki;
+            if degenerate[si as usize] {
+                continue;
+            }
+            for kj in 0..4u32 {
+                let sj = 4 * j + kj;
+                if degenerate[sj as usize]
+                    || !h.sub.is_none_or_after((si, sj))
+                    || !overlap(&bi[ki as usize], &bj[kj as usize])
+                {
+                    continue;
+                }
+                if flat_conflict(nodes, sub_ids(tris, si), sub_ids(tris, sj)) {
+                    h.sub = Some((si, sj));
+                }
+            }
+        }
+    };
+    let merge = |a: Hits, b: Hits| Hits {
+        chord: min_opt(a.chord, b.chord),
+        sub: min_opt(a.sub, b.sub),
+    };
+    let hits = grid.fold_pairs(&boxes, Hits::default, visit, merge);
+
+    if let Some((i, j)) = hits.chord {
         let (i, j) = (i as usize, j as usize);
         return Err(Error::surface(
             SurfaceDefect::SelfIntersection,
@@ -88,46 +179,35 @@ pub fn check_chords(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
             ),
         ));
     }
-    Ok(())
-}
-
-/// Node ids of sub-triangle `s` (= 4 * triangle + k).
-fn sub_ids(tris: &[[u32; 6]], s: u32) -> [u32; 3] {
-    let t = &tris[(s / 4) as usize];
-    SUB_TRIANGLES[(s % 4) as usize].map(|k| t[k])
-}
-
-/// The four flat sub-triangles of every curved triangle do not meet except at shared
-/// nodes and edges (see the module docs). Chord triangles must have passed.
-pub fn check_curved(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
-    let n_sub = 4 * tris.len();
-    for s in 0..n_sub as u32 {
-        let id = sub_ids(tris, s);
-        let [a, b, c] = id.map(|v| nodes[v as usize]);
-        if collinear(a, b, c) {
-            let t = (s / 4) as usize;
-            return Err(Error::surface(
-                SurfaceDefect::FoldedTriangle,
-                format!(
-                    "{}: the flat sub-triangle (nodes {}, {}, {}) of its corner/mid-node split \
-                     is degenerate (collinear nodes), so the curved triangle is degenerate or \
-                     cannot be certified embedded",
-                    describe::tri(t, &tris[t]),
-                    id[0],
-                    id[1],
-                    id[2]
-                ),
-            ));
-        }
+    if let Some(s) = degenerate.iter().position(|&d| d) {
+        let t = s / 4;
+        let id = sub_ids(tris, s as u32);
+        return Err(Error::surface(
+            SurfaceDefect::FoldedTriangle,
+            format!(
+                "{}: the flat sub-triangle (nodes {}, {}, {}) of its corner/mid-node split \
+                 is degenerate (collinear nodes), so the curved triangle is degenerate or \
+                 cannot be certified embedded",
+                describe::tri(t, &tris[t]),
+                id[0],
+                id[1],
+                id[2]
+            ),
+        ));
     }
-    let boxes: Vec<Aabb> = (0..n_sub as u32)
-        .map(|s| bbox(sub_ids(tris, s).map(|v| nodes[v as usize])))
-        .collect();
-    let grid = Grid::build(&boxes);
-    let hit = grid.min_conflict(&boxes, |i, j| {
-        flat_conflict(nodes, sub_ids(tris, i), sub_ids(tris, j))
+    // Pairs of sub-triangles of the same triangle.
+    let own = (0..tris.len() as u32).into_par_iter().find_map_first(|t| {
+        for k in 0..4 {
+            for l in k + 1..4 {
+                let (si, sj) = (4 * t + k, 4 * t + l);
+                if flat_conflict(nodes, sub_ids(tris, si), sub_ids(tris, sj)) {
+                    return Some((si, sj));
+                }
+            }
+        }
+        None
     });
-    if let Some((i, j)) = hit {
+    if let Some((i, j)) = min_opt(hits.sub, own) {
         let (ti, tj) = ((i / 4) as usize, (j / 4) as usize);
         let (si, sj) = (sub_ids(tris, i), sub_ids(tris, j));
         let what = if ti == tj {
@@ -150,4 +230,19 @@ pub fn check_curved(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// `None`, or a pair after `p` (so `p` would be a new minimum).
+trait NoneOrAfter {
+    fn is_none_or_after(&self, p: (u32, u32)) -> bool;
+}
+
+impl NoneOrAfter for Option<(u32, u32)> {
+    #[inline]
+    fn is_none_or_after(&self, p: (u32, u32)) -> bool {
+        match self {
+            None => true,
+            Some(c) => p < *c,
+        }
+    }
 }

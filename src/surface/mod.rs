@@ -113,8 +113,7 @@ impl Surface {
         let topo = topology::Topology::build(&nodes, &tris)?;
         geometry::check_degenerate(&nodes, &tris)?;
         geometry::check_folded(&nodes, &tris)?;
-        intersect::check_chords(&nodes, &tris)?;
-        intersect::check_curved(&nodes, &tris)?;
+        intersect::check_intersections(&nodes, &tris)?;
         let mut warnings = Vec::new();
         let mut neighbors = topo.neighbors;
         let mut edges = topo.edges;
