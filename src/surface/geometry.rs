@@ -8,7 +8,8 @@
 //!
 //! **Folded**: on the order-6 lattice (the 28 points (i/6, j/6), i + j <= 6, corners and
 //! edges included) the curved normal `tri6_normal` must have a positive dot product with
-//! the chord triangle's normal; the smallest cosine between them is the triangle's
+//! the chord triangle's normal (the tangents are evaluated in closed form; a test checks
+//! them against `tri6_normal`); the smallest cosine between them is the triangle's
 //! "n.cos". Any cosine <= 0 (including a vanishing curved normal) →
 //! [`FoldedTriangle`](SurfaceDefect::FoldedTriangle), naming the triangle, the minimum
 //! cosine and where it occurs. This is a sampled, metric check (as in the data README),
@@ -19,7 +20,6 @@ use rayon::prelude::*;
 use super::describe;
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::predicates::collinear;
-use crate::geom::shape::tri6_normal;
 use crate::geom::vec3::{cross, dot, norm, scale, sub};
 use crate::geom::P3;
 
@@ -81,12 +81,34 @@ pub fn min_normal_cosine_of(x: &[P3; 6]) -> NormalSample {
         return NormalSample::ChordUnderflow;
     }
     let nc = scale(nc, 1.0 / lc);
+    // The tangents are affine in (u, v): x_u = tu0 + u tuu + v tuv, x_v = tv0 + u tuv + v tvv
+    // (from the Gmsh-order P2 shape functions), so each lattice point costs two affine
+    // evaluations and a cross product.
+    let (x0, x1, x2, m01, m12, m20) = (y[0], y[1], y[2], y[3], y[4], y[5]);
+    let comb = |c: [f64; 6]| -> P3 {
+        [0, 1, 2].map(|d| {
+            c[0] * x0[d]
+                + c[1] * x1[d]
+                + c[2] * x2[d]
+                + c[3] * m01[d]
+                + c[4] * m12[d]
+                + c[5] * m20[d]
+        })
+    };
+    let tu0 = comb([-3.0, -1.0, 0.0, 4.0, 0.0, 0.0]);
+    let tv0 = comb([-3.0, 0.0, -1.0, 0.0, 0.0, 4.0]);
+    let tuu = comb([4.0, 4.0, 0.0, -8.0, 0.0, 0.0]);
+    let tvv = comb([4.0, 0.0, 4.0, 0.0, 0.0, -8.0]);
+    let tuv = comb([4.0, 0.0, 0.0, -4.0, 4.0, -4.0]);
     let mut best = (f64::INFINITY, [0u8; 2]);
     let q = FOLD_LATTICE_ORDER;
     for i in 0..=q {
+        let u = i as f64 / q as f64;
         for j in 0..=(q - i) {
-            let (u, v) = (i as f64 / q as f64, j as f64 / q as f64);
-            let n = tri6_normal(&y, u, v);
+            let v = j as f64 / q as f64;
+            let xu = [0, 1, 2].map(|d| tu0[d] + u * tuu[d] + v * tuv[d]);
+            let xv = [0, 1, 2].map(|d| tv0[d] + u * tuv[d] + v * tvv[d]);
+            let n = cross(xu, xv);
             let l = norm(n);
             let c = if l > 0.0 && l.is_finite() {
                 dot(n, nc) / l
@@ -145,4 +167,36 @@ pub fn min_normal_cosine(nodes: &[P3], tris: &[[u32; 6]]) -> f64 {
             NormalSample::ChordUnderflow => 0.0,
         })
         .reduce(|| f64::INFINITY, f64::min)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::shape::tri6_normal;
+
+    /// The closed-form tangents agree with `tri6_normal` (the reference shape functions).
+    #[test]
+    fn lattice_normals_match_shape_functions() {
+        let x: [P3; 6] = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [0.2, 1.0, 0.1],
+            [0.5, -0.1, 0.2],
+            [0.7, 0.6, 0.3],
+            [0.0, 0.5, -0.2],
+        ];
+        let nc = crate::geom::vec3::normalize(cross(x[1], x[2]));
+        let mut want = f64::INFINITY;
+        for i in 0..=6 {
+            for j in 0..=(6 - i) {
+                let n = tri6_normal(&x, i as f64 / 6.0, j as f64 / 6.0);
+                want = want.min(dot(n, nc) / norm(n));
+            }
+        }
+        let NormalSample::MinCos(got, _) = min_normal_cosine_of(&x) else {
+            panic!("no sample");
+        };
+        assert!((got - want).abs() < 1e-12, "{got} vs {want}");
+        assert!(got < 0.99);
+    }
 }

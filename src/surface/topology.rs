@@ -21,6 +21,8 @@
 //! [`NonManifoldVertex`](SurfaceDefect::NonManifoldVertex) (e.g. two bodies touching at a
 //! vertex). As a consequence, distinct shells share no vertex.
 
+use rayon::prelude::*;
+
 use super::describe;
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::P3;
@@ -61,7 +63,7 @@ impl Topology {
                 rec.push((a.min(b), a.max(b), t as u32, k));
             }
         }
-        rec.sort_unstable();
+        rec.par_sort_unstable();
 
         let mut non_manifold: Option<String> = None;
         let mut open: Option<String> = None;
