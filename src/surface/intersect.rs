@@ -195,10 +195,6 @@ fn segments_meet(o: &impl Fn(P3, P3, P3) -> i32, p: P3, q: P3, r: P3, s: P3) -> 
         || (o4 == 0 && on(r, s, q))
 }
 
-fn corners(tri: &[u32; 6]) -> [u32; 3] {
-    [tri[0], tri[1], tri[2]]
-}
-
 /// Node ids of sub-triangle `s` (= 4 * triangle + k).
 fn sub_ids(tris: &[[u32; 6]], s: u32) -> [u32; 3] {
     let t = &tris[(s / 4) as usize];

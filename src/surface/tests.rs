@@ -797,3 +797,90 @@ fn ray_crossing_sos() {
         .count();
     assert_eq!(hits, 1);
 }
+
+// ---------------------------------------------------------------- robustness
+
+/// Random mutations of valid surfaces (indices, coordinates, triangle order and count)
+/// never panic: every input gives `Ok` or an error.
+#[test]
+fn random_mutations_never_panic() {
+    use rand::{rngs::StdRng, Rng, SeedableRng};
+    let mut rng = StdRng::seed_from_u64(11);
+    let bases = [
+        octahedron(1.0),
+        icosahedron(),
+        cube(),
+        unit_tet().union(&tet([
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [2.0, 0.0, 1.0],
+        ])),
+    ];
+    let specials = [
+        0.0,
+        -0.0,
+        1.0,
+        0.5,
+        1e-70,
+        1e300,
+        f64::NAN,
+        f64::INFINITY,
+        1e30,
+        -1e30,
+    ];
+    let mut outcomes = [0usize; 2];
+    for it in 0..3000 {
+        let mut s = bases[it % bases.len()].clone();
+        for _ in 0..rng.random_range(1..4) {
+            let nn = s.nodes.len() as u32;
+            match rng.random_range(0..8) {
+                0 => {
+                    let t = rng.random_range(0..s.tris.len());
+                    let k = rng.random_range(0..6);
+                    s.tris[t][k] = rng.random_range(0..nn + 2);
+                }
+                1 => {
+                    let i = rng.random_range(0..s.nodes.len());
+                    let d = rng.random_range(0..3);
+                    s.nodes[i][d] = specials[rng.random_range(0..specials.len())];
+                }
+                2 => {
+                    let i = rng.random_range(0..s.nodes.len());
+                    let j = rng.random_range(0..s.nodes.len());
+                    s.nodes[i] = s.nodes[j];
+                }
+                3 => {
+                    let i = rng.random_range(0..s.nodes.len());
+                    for d in 0..3 {
+                        s.nodes[i][d] += rng.random_range(-0.6..0.6);
+                    }
+                }
+                4 if s.tris.len() > 1 => {
+                    let t = rng.random_range(0..s.tris.len());
+                    s.tris.remove(t);
+                }
+                5 => {
+                    let t = rng.random_range(0..s.tris.len());
+                    let tri = s.tris[t];
+                    s.tris.push(tri);
+                }
+                6 => {
+                    let t = rng.random_range(0..s.tris.len());
+                    let x = s.tris[t];
+                    s.tris[t] = [x[0], x[2], x[1], x[5], x[4], x[3]];
+                }
+                _ => {
+                    let t = rng.random_range(0..s.tris.len());
+                    s.tris[t].swap(rng.random_range(0..6), rng.random_range(0..6));
+                }
+            }
+        }
+        let r = std::panic::catch_unwind(|| s.check().is_ok());
+        match r {
+            Ok(ok) => outcomes[ok as usize] += 1,
+            Err(_) => panic!("panic on mutated surface {it}: {s:?}"),
+        }
+    }
+    assert!(outcomes[0] > 100, "{outcomes:?}");
+}
