@@ -1,30 +1,33 @@
-//! Exact self-intersection checks, broad phase by a uniform grid ([`super::grid`]), so the
+//! Exact self-intersection checks, broad phase by a uniform grid (`surface/grid.rs`), so the
 //! cost stays about O(n log n) for reasonable meshes.
 //!
 //! Both levels run in one pass ([`check_intersections`]) over the pairs of curved
 //! triangles whose six-node bounding boxes overlap; a chord-level conflict anywhere is
 //! reported before any curved-level one.
 //!
-//! **Chord level**: every pair of flat chord (corner) triangles whose
-//! bounding boxes overlap is tested with the exact `triangle_triangle_conflict`: meeting
-//! at shared vertices or along a shared edge is fine, any other contact (touching,
-//! crossing, coplanar overlap) is a
+//! **Chord level**: every pair of flat chord (corner) triangles whose bounding boxes
+//! overlap is tested exactly (`flat_conflict`: exact early outs, a 2D path for coplanar
+//! pairs, else the exact `triangle_triangle_conflict`; a test checks it agrees with the
+//! latter): meeting at shared vertices or along a shared edge is fine, any other contact
+//! (touching, crossing, coplanar overlap) is a
 //! [`SelfIntersection`](SurfaceDefect::SelfIntersection), naming both triangles. Two
 //! triangles with the same three corners coincide and are reported too.
 //!
-//! **Curved level**: each P2 triangle is split at its mid nodes into
-//! four flat sub-triangles (c0 m01 m20, m01 c1 m12, m20 m12 c2, m01 m12 m20) and every
-//! overlapping pair of sub-triangles (of the same or different triangles; shared nodes
-//! are judged by id) is tested the same way. A conflict there is also an **error**
-//! ([`SelfIntersection`](SurfaceDefect::SelfIntersection)), not a warning: the
-//! sub-triangles pass through all six nodes of each curved triangle, so a conflict means
-//! some boundary node (in practice a mid node) sits on the wrong side of another part of
-//! the surface. The mesher keeps every boundary node exactly and builds its tets from
-//! them, so such an input cannot give a valid curved mesh (the final certification would
-//! fail, later and less clearly). The split is a conservative proxy, not a proof: it
-//! can miss an intersection of the curved patches between nodes, which the final
-//! Jacobian certification still catches. A sub-triangle whose three nodes are exactly
-//! collinear cannot be tested and is reported as a
+//! **Curved level**: each P2 triangle is split at its mid nodes into four flat
+//! sub-triangles (c0 m01 m20, m01 c1 m12, m20 m12 c2, m01 m12 m20) and every overlapping
+//! pair of sub-triangles (of the same or different triangles; shared nodes are judged by
+//! id) is tested the same way. A conflict there is also an **error**
+//! ([`SelfIntersection`](SurfaceDefect::SelfIntersection)), not a warning: the split is
+//! the piecewise-flat surface through all six nodes of every curved triangle, so a
+//! conflict means the boundary nodes themselves are entangled (typically a mid node pokes
+//! through a nearby sheet). The mesher keeps every boundary node exactly and builds its
+//! tets from them, so such an input cannot give a valid curved mesh; the final Jacobian
+//! certification would fail later and less clearly. The split is a proxy of the curved
+//! surface, not a proof either way: it can miss an intersection of the curved patches
+//! between nodes (the final certification still catches that), and it could reject two
+//! sheets that pass closer than their deviation from the split without touching (the six
+//! benchmark surfaces, thin-walled LV and hinge included, pass). A sub-triangle whose
+//! three nodes are exactly collinear cannot be tested and is reported as a
 //! [`FoldedTriangle`](SurfaceDefect::FoldedTriangle) (such a split does not occur in a
 //! sensible curved triangle).
 
