@@ -1,6 +1,56 @@
 //! The input side: the P2 surface model and its checks.
+//!
+//! [`Surface::new`] is the only way to build a [`Surface`]; it runs every check below, in
+//! this order (cheap and fundamental first), and returns the first failure as
+//! [`Error::InvalidSurface`] with a [`SurfaceDefect`] kind and a message naming the
+//! triangle (0-based index and corner nodes), edge (its two nodes) or node (index and
+//! coordinates):
+//!
+//! 1. [`indices`]: no triangles ([`Empty`](SurfaceDefect::Empty)); a node index past the
+//!    end ([`IndexOutOfRange`](SurfaceDefect::IndexOutOfRange)); a triangle using a node
+//!    twice among its six ([`RepeatedNode`](SurfaceDefect::RepeatedNode)).
+//! 2. [`coords`]: NaN/Inf ([`NonFiniteCoordinate`](SurfaceDefect::NonFiniteCoordinate));
+//!    the range the exact predicates need ([`CoordinateRange`](SurfaceDefect::CoordinateRange),
+//!    limits in [`coords::MAX_ABS_COORDINATE`] and friends).
+//! 3. Unused nodes ([`UnusedNode`](SurfaceDefect::UnusedNode)), then identical
+//!    coordinates ([`DuplicateNode`](SurfaceDefect::DuplicateNode), by sorting).
+//! 4. [`topology`]: the corner-edge rule (see there) — non-manifold edges, open edges,
+//!    edges used twice in one direction, mid-node sharing; then one fan per vertex.
+//! 5. [`geometry`]: exactly collinear corners; folded curved triangles (order-6 lattice).
+//! 6. [`intersect`]: exact self-intersection of the chord triangles, then of the four flat
+//!    sub-triangles of every curved triangle (both are errors; see there why).
+//! 7. [`orientation`]: per shell, the exact sign of the enclosed chord volume and the
+//!    nesting depth (exact ray parity); an all-inward surface is flipped with a warning,
+//!    a mixed one is an error.
 
+pub mod coords;
+mod describe;
+mod exact_sum;
+pub mod geometry;
+mod grid;
+pub mod indices;
+pub mod intersect;
+pub mod measure;
+pub mod orientation;
+pub mod topology;
+
+#[cfg(test)]
+mod tests;
+
+use std::collections::HashMap;
+
+#[cfg(doc)]
+use crate::error::SurfaceDefect;
+use crate::error::{Error, Result};
 use crate::geom::P3;
+
+pub use topology::SurfaceEdge;
+
+/// The warning recorded when an inside-out surface was flipped.
+pub const FLIPPED_WARNING: &str = "orientation was inward; flipped";
+
+/// Most triangles a surface may have: sub-triangle ids (4 per triangle) must fit in `u32`.
+pub const MAX_TRIANGLES: usize = 1 << 29;
 
 /// A closed quadratic (6-node) triangle surface: the input of the mesher.
 ///
@@ -14,9 +64,78 @@ pub struct Surface {
     tris: Vec<[u32; 6]>,
     tags: Vec<i32>,
     warnings: Vec<String>,
+    /// Sorted corner node ids.
+    corners: Vec<u32>,
+    /// Corner edges sorted by `nodes` (smaller id first).
+    edges: Vec<SurfaceEdge>,
+    /// Per triangle, the neighbour across local edge k (corners k -> k+1).
+    neighbors: Vec<[u32; 3]>,
+    /// Per triangle, its shell (connected component), numbered by lowest triangle.
+    shell: Vec<u32>,
+    shell_count: usize,
 }
 
 impl Surface {
+    /// Checks a P2 surface and builds it.
+    ///
+    /// `nodes` are coordinates; `tris` are 6-node triangles (0-based node indices, Gmsh
+    /// order); `tags` gives one tag per triangle, or is empty (all tags 0). Runs every
+    /// check listed in the [module docs](self) and returns the first failure; a
+    /// consistently inward surface is flipped (see [`FLIPPED_WARNING`]).
+    pub fn new(nodes: Vec<P3>, mut tris: Vec<[u32; 6]>, tags: Vec<i32>) -> Result<Surface> {
+        let tags = if tags.is_empty() {
+            vec![0; tris.len()]
+        } else if tags.len() != tris.len() {
+            return Err(Error::InvalidArgument(format!(
+                "{} tags for {} triangles (give one tag per triangle, or none)",
+                tags.len(),
+                tris.len()
+            )));
+        } else {
+            tags
+        };
+        if tris.len() > MAX_TRIANGLES {
+            return Err(Error::InvalidArgument(format!(
+                "{} triangles: at most {MAX_TRIANGLES} are supported",
+                tris.len()
+            )));
+        }
+        if nodes.len() > u32::MAX as usize {
+            return Err(Error::InvalidArgument(format!(
+                "{} nodes: node indices are u32",
+                nodes.len()
+            )));
+        }
+        indices::check_indices(nodes.len(), &tris)?;
+        coords::check_coordinates(&nodes)?;
+        indices::check_unused(nodes.len(), &tris, &nodes)?;
+        coords::check_duplicates(&nodes)?;
+        let topo = topology::Topology::build(&nodes, &tris)?;
+        geometry::check_degenerate(&nodes, &tris)?;
+        geometry::check_folded(&nodes, &tris)?;
+        intersect::check_intersections(&nodes, &tris)?;
+        let mut warnings = Vec::new();
+        let mut neighbors = topo.neighbors;
+        let mut edges = topo.edges;
+        if orientation::check_orientation(&nodes, &tris, &topo.shell, topo.shell_count)?
+            == orientation::Verdict::Inward
+        {
+            orientation::flip_all(&mut tris, &mut neighbors, &mut edges);
+            warnings.push(FLIPPED_WARNING.to_string());
+        }
+        Ok(Surface {
+            nodes,
+            tris,
+            tags,
+            warnings,
+            corners: topo.corners,
+            edges,
+            neighbors,
+            shell: topo.shell,
+            shell_count: topo.shell_count,
+        })
+    }
+
     /// Nodes (corners and mid-edge nodes).
     pub fn nodes(&self) -> &[P3] {
         &self.nodes
@@ -29,8 +148,86 @@ impl Surface {
     pub fn tags(&self) -> &[i32] {
         &self.tags
     }
-    /// Warnings raised while checking (e.g. "orientation was inward; flipped").
+    /// Warnings raised while checking (e.g. [`FLIPPED_WARNING`]).
     pub fn warnings(&self) -> &[String] {
         &self.warnings
+    }
+
+    /// Corner (vertex) node ids, sorted. The mesher's candidate points on the boundary.
+    pub fn corner_nodes(&self) -> &[u32] {
+        &self.corners
+    }
+
+    /// Is `node` a corner of some triangle (rather than a mid-edge node)?
+    pub fn is_corner(&self, node: u32) -> bool {
+        self.corners.binary_search(&node).is_ok()
+    }
+
+    /// Mid-edge node ids, sorted (every node is either a corner or a mid node).
+    pub fn mid_nodes(&self) -> Vec<u32> {
+        let mut m: Vec<u32> = self.edges.iter().map(|e| e.mid).collect();
+        m.sort_unstable();
+        m
+    }
+
+    /// Corner edges, sorted by their node pair (smaller id first): each with its mid
+    /// node and its two triangles. Binary-search it, or use [`Surface::mid_node`].
+    pub fn edges(&self) -> &[SurfaceEdge] {
+        &self.edges
+    }
+
+    /// The mid node of corner edge (a, b) in either order, if it is an edge.
+    pub fn mid_node(&self, a: u32, b: u32) -> Option<u32> {
+        let key = [a.min(b), a.max(b)];
+        self.edges
+            .binary_search_by(|e| e.nodes.cmp(&key))
+            .ok()
+            .map(|i| self.edges[i].mid)
+    }
+
+    /// The corner edge -> mid node map as a `HashMap` keyed by `(min, max)` node ids.
+    pub fn edge_mid_map(&self) -> HashMap<(u32, u32), u32> {
+        self.edges
+            .iter()
+            .map(|e| ((e.nodes[0], e.nodes[1]), e.mid))
+            .collect()
+    }
+
+    /// Per triangle, the neighbouring triangle across local edge k (corners k -> k+1).
+    pub fn neighbors(&self) -> &[[u32; 3]] {
+        &self.neighbors
+    }
+
+    /// Per triangle, the id of its shell (connected component through edges); shells are
+    /// numbered in order of their lowest triangle.
+    pub fn shell_ids(&self) -> &[u32] {
+        &self.shell
+    }
+
+    /// Number of shells (1 for a simple body; more for cavities or separate bodies).
+    pub fn shell_count(&self) -> usize {
+        self.shell_count
+    }
+
+    /// Volume enclosed by the curved P2 surface (divergence theorem, exact for P2 up to
+    /// rounding: the integrand is a degree-4 polynomial).
+    pub fn volume(&self) -> f64 {
+        measure::curved_volume(&self.nodes, &self.tris)
+    }
+
+    /// Volume enclosed by the chord (corner-only) triangles.
+    pub fn chord_volume(&self) -> f64 {
+        measure::chord_volume(&self.nodes, &self.tris)
+    }
+
+    /// Smallest cosine between the curved normal and the chord normal over all
+    /// triangles, on the order-6 lattice (1 for flat triangles; > 0 since checked).
+    pub fn min_normal_cosine(&self) -> f64 {
+        geometry::min_normal_cosine(&self.nodes, &self.tris)
+    }
+
+    /// Takes the surface apart: (nodes, triangles, tags).
+    pub fn into_parts(self) -> (Vec<P3>, Vec<[u32; 6]>, Vec<i32>) {
+        (self.nodes, self.tris, self.tags)
     }
 }
