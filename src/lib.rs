@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod front;
+pub mod generate;
 pub mod geom;
 pub mod io;
 pub mod mesh;
@@ -15,6 +16,7 @@ pub mod options;
 pub mod surface;
 
 pub use error::{Error, Result, SurfaceDefect};
+pub use generate::{generate, generate_with_progress, Generated};
 pub use mesh::TetMesh;
 pub use options::{Options, SizeMode};
 pub use surface::Surface;

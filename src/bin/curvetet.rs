@@ -1,3 +1,412 @@
-fn main() {
-    println!("curvetet {}", env!("CARGO_PKG_VERSION"));
+//! `curvetet`: the command-line tool. Messages go to stderr, results to stdout; the exit
+//! code is 0 only on success.
+
+use clap::{Args, Parser, Subcommand};
+use curvetet::geom::quadrature::{enclosed_volume, enclosed_volume_linear};
+use curvetet::io::{self, MshVersion, WriteOptions};
+use curvetet::mesh::quality::QualityReport;
+use curvetet::mesh::{check, TetMesh};
+use curvetet::{Error, Generated, Options, SizeMode, Surface};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "curvetet",
+    version,
+    about = "Quadratic (10-node) curved tetrahedral meshes, directly from a closed quadratic (6-node) triangle surface"
+)]
+struct Cli {
+    #[command(subcommand)]
+    cmd: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Mesh a closed P2 surface (.msh, .vtu, .vtk, .mesh) into a P2 tet mesh.
+    Mesh(MeshArgs),
+    /// Check a surface or a volume mesh and print its report.
+    Check {
+        /// The file to check.
+        file: PathBuf,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Convert a mesh between formats (by extension: .msh .vtu .vtk .mesh).
+    Convert {
+        /// Input file.
+        input: PathBuf,
+        /// Output file.
+        output: PathBuf,
+        #[command(flatten)]
+        write: WriteArgs,
+    },
+    /// The built-in example: a P2 torus surface built analytically, meshed.
+    Demo {
+        /// Where to write the volume mesh.
+        #[arg(short, long, default_value = "demo_torus.msh")]
+        output: PathBuf,
+        /// Also write the P2 surface here.
+        #[arg(long)]
+        surface: Option<PathBuf>,
+        /// Only build and write the surface (to --output), do not mesh.
+        #[arg(long)]
+        surface_only: bool,
+        /// Approximate number of surface triangles.
+        #[arg(long, default_value_t = 1728)]
+        triangles: usize,
+        #[command(flatten)]
+        mesh: MeshOptions,
+    },
+}
+
+#[derive(Args)]
+struct MeshArgs {
+    /// Input surface.
+    input: PathBuf,
+    /// Output volume mesh (.msh, .vtu, .vtk, .mesh).
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    mesh: MeshOptions,
+}
+
+#[derive(Args)]
+struct MeshOptions {
+    /// Search radius factor: candidates within ALPHA * h of the ideal point.
+    #[arg(long, default_value_t = 1.5)]
+    alpha: f64,
+    /// Uniform target edge length (default: graded from the boundary triangles).
+    #[arg(long)]
+    size: Option<f64>,
+    /// The paper's uniform size from the mean curved triangle area (eq. 1).
+    #[arg(long, conflicts_with = "size")]
+    uniform_size: bool,
+    /// Skip quality improvement and high-order optimization.
+    #[arg(long)]
+    no_optimize: bool,
+    /// Worker threads (0 = all cores); the result does not depend on it.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Write the quality report as JSON here.
+    #[arg(long)]
+    report: Option<PathBuf>,
+    /// On failure, write what was meshed anyway (for debugging).
+    #[arg(long)]
+    keep_partial: bool,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+    #[command(flatten)]
+    write: WriteArgs,
+}
+
+#[derive(Args)]
+struct WriteArgs {
+    /// Write Gmsh MSH 2.2 instead of 4.1.
+    #[arg(long)]
+    msh22: bool,
+    /// Write binary (.msh only).
+    #[arg(long)]
+    binary: bool,
+}
+
+impl WriteArgs {
+    fn options(&self) -> WriteOptions {
+        WriteOptions {
+            msh_version: if self.msh22 {
+                MshVersion::V22
+            } else {
+                MshVersion::V41
+            },
+            binary: self.binary,
+            ..WriteOptions::default()
+        }
+    }
+}
+
+impl MeshOptions {
+    fn options(&self) -> Options {
+        Options {
+            alpha: self.alpha,
+            size: match (self.size, self.uniform_size) {
+                (Some(h), _) => SizeMode::Fixed(h),
+                (None, true) => SizeMode::Uniform,
+                (None, false) => SizeMode::Graded,
+            },
+            optimize: !self.no_optimize,
+            threads: self.threads,
+            ..Options::default()
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let r = match cli.cmd {
+        Cmd::Mesh(a) => cmd_mesh(&a),
+        Cmd::Check { file, json } => cmd_check(&file, json),
+        Cmd::Convert {
+            input,
+            output,
+            write,
+        } => cmd_convert(&input, &output, &write),
+        Cmd::Demo {
+            output,
+            surface,
+            surface_only,
+            triangles,
+            mesh,
+        } => cmd_demo(&output, surface.as_deref(), surface_only, triangles, &mesh),
+    };
+    match r {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(exit_code(&e))
+        }
+    }
+}
+
+/// Exit codes: 1 bad arguments, 2 I/O, 3 parse, 4 invalid surface, 5 meshing failed,
+/// 6 invalid mesh, 7 cancelled (the C ABI's status codes).
+fn exit_code(e: &Error) -> u8 {
+    match e {
+        Error::InvalidArgument(_) => 1,
+        Error::Io { .. } => 2,
+        Error::Parse { .. } => 3,
+        Error::InvalidSurface { .. } => 4,
+        Error::MeshingFailed { .. } => 5,
+        Error::InvalidMesh { .. } => 6,
+        Error::Cancelled => 7,
+    }
+}
+
+fn progress_bar(quiet: bool) -> ProgressBar {
+    if quiet || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+    pb.set_style(
+        ProgressStyle::with_template("{msg:>8} [{bar:40}] {percent:>3}% {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb
+}
+
+fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Error> {
+    for w in surface.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let opts = m.options();
+    let pb = progress_bar(m.quiet);
+    let mut cb = |f: f64, stage: &str| {
+        pb.set_message(stage.to_string());
+        pb.set_position((f * 1000.0) as u64);
+        false
+    };
+    let r = curvetet::generate_with_progress(surface, &opts, &mut cb);
+    pb.finish_and_clear();
+    let g: Generated = match r {
+        Ok(g) => g,
+        Err(e) => {
+            if m.keep_partial {
+                let partial = match &e {
+                    Error::MeshingFailed {
+                        partial: Some(p), ..
+                    } => Some(p),
+                    Error::InvalidMesh { mesh: Some(p), .. } => Some(p),
+                    _ => None,
+                };
+                if let Some(p) = partial {
+                    io::write_mesh(output, p, &m.write.options())?;
+                    eprintln!(
+                        "wrote the partial mesh to {} (--keep-partial)",
+                        output.display()
+                    );
+                }
+            }
+            return Err(e);
+        }
+    };
+    io::write_mesh(output, &g.mesh, &m.write.options())?;
+    let r = &g.report;
+    eprintln!(
+        "{} tets, {} nodes in {:.3} s (front {:.3} s); min scaled Jacobian {:.3} (certified {:.3}), max skewness {:.3}, dihedral {:.1}..{:.1} deg",
+        r.num_tets,
+        r.num_nodes,
+        g.times.front + g.times.assemble + g.times.optimize + g.times.certify + g.times.size_field,
+        g.times.front,
+        r.quality.scaled_jacobian.min,
+        r.quality.scaled_jacobian_certified.min,
+        r.quality.skewness.max,
+        r.quality.min_dihedral.min,
+        r.quality.max_dihedral.max,
+    );
+    eprintln!("wrote {}", output.display());
+    if let Some(path) = &m.report {
+        let json = serde_json::json!({
+            "input_triangles": surface.triangles().len(),
+            "report": r,
+            "front": g.front,
+            "times": g.times,
+            "size": g.size,
+        });
+        let text = serde_json::to_string_pretty(&json)
+            .map_err(|e| Error::InvalidArgument(e.to_string()))?;
+        std::fs::write(path, text).map_err(|e| Error::io(path, e))?;
+    }
+    Ok(())
+}
+
+fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
+    let surface = io::read_surface(&a.input)?;
+    run_mesh(&surface, &a.mesh, &a.output)
+}
+
+fn cmd_demo(
+    output: &Path,
+    surface_out: Option<&Path>,
+    surface_only: bool,
+    n: usize,
+    m: &MeshOptions,
+) -> Result<(), Error> {
+    let (big_r, r) = (1.0, 0.35);
+    let (nu, nv) = curvetet::surface::demo::torus_resolution(n, big_r, r);
+    let (nodes, tris) = curvetet::surface::demo::torus(nu, nv, big_r, r);
+    let surface = Surface::new(nodes, tris, vec![])?;
+    eprintln!(
+        "demo: P2 torus R = {big_r}, r = {r}: {} triangles, {} nodes, enclosed volume {:.9} (exact {:.9})",
+        surface.triangles().len(),
+        surface.nodes().len(),
+        enclosed_volume(surface.nodes(), surface.triangles()),
+        2.0 * std::f64::consts::PI.powi(2) * big_r * r * r
+    );
+    let wopts = m.write.options();
+    if surface_only {
+        io::write_surface(
+            output,
+            surface.nodes(),
+            surface.triangles(),
+            surface.tags(),
+            &wopts,
+        )?;
+        eprintln!("wrote {}", output.display());
+        return Ok(());
+    }
+    if let Some(p) = surface_out {
+        io::write_surface(
+            p,
+            surface.nodes(),
+            surface.triangles(),
+            surface.tags(),
+            &wopts,
+        )?;
+        eprintln!("wrote {}", p.display());
+    }
+    run_mesh(&surface, m, output)
+}
+
+fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> {
+    let raw = io::read(input)?;
+    if raw.tet10.is_empty() {
+        let s = io::surface_from_raw(raw, &input.display().to_string())?;
+        io::write_surface(output, s.nodes(), s.triangles(), s.tags(), &w.options())?;
+    } else {
+        let m = raw.into_tet_mesh()?;
+        io::write_mesh(output, &m, &w.options())?;
+    }
+    eprintln!("wrote {}", output.display());
+    Ok(())
+}
+
+fn cmd_check(path: &Path, json: bool) -> Result<(), Error> {
+    let raw = io::read(path)?;
+    let name = path.display().to_string();
+    if raw.tet10.is_empty() && raw.tet4.is_empty() {
+        let s = io::surface_from_raw(raw, &name)?;
+        for w in s.warnings() {
+            eprintln!("warning: {w}");
+        }
+        let v = enclosed_volume(s.nodes(), s.triangles());
+        let vl = enclosed_volume_linear(s.nodes(), s.triangles());
+        let corners = s.corner_nodes().len();
+        if json {
+            let j = serde_json::json!({
+                "kind": "surface", "file": name, "valid": true,
+                "nodes": s.nodes().len(), "corner_nodes": corners, "triangles": s.triangles().len(),
+                "shells": s.shell_count(), "enclosed_volume": v, "enclosed_volume_linear": vl,
+                "min_normal_cosine": s.min_normal_cosine(), "warnings": s.warnings(),
+            });
+            println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+        } else {
+            println!("{name}: valid closed P2 surface");
+            println!(
+                "  nodes {} ({corners} corners), triangles {}, shells {}",
+                s.nodes().len(),
+                s.triangles().len(),
+                s.shell_count()
+            );
+            println!("  enclosed volume {v:.12} (linear {vl:.12})");
+            println!(
+                "  min cos(curved normal, chord normal) {:.4}",
+                s.min_normal_cosine()
+            );
+        }
+        return Ok(());
+    }
+    let m: TetMesh = raw.into_tet_mesh()?;
+    let conf = check::check_conformity(&m)?;
+    let report = QualityReport::of(&m);
+    let rel = (conf.volume_linear - conf.enclosed_linear).abs() / conf.enclosed_linear.abs();
+    let ok = report.num_invalid == 0 && rel <= 1e-10;
+    if json {
+        let j = serde_json::json!({
+            "kind": "volume", "file": name, "valid": ok, "conformity": conf,
+            "volume_relative_difference": rel, "report": report,
+        });
+        println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+    } else {
+        let q = &report.quality;
+        println!(
+            "{name}: {} P2 volume mesh",
+            if ok { "valid" } else { "INVALID" }
+        );
+        println!(
+            "  tets {}, nodes {}, boundary triangles {}",
+            report.num_tets, report.num_nodes, report.num_boundary_faces
+        );
+        println!(
+            "  conforming: {} interior faces shared by two tets, boundary closed",
+            conf.interior_faces
+        );
+        println!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved);
+        println!("  certified-invalid elements: {}", report.num_invalid);
+        println!(
+            "  scaled Jacobian min {:.4} (certified {:.4}) mean {:.4}",
+            q.scaled_jacobian.min, q.scaled_jacobian_certified.min, q.scaled_jacobian.mean
+        );
+        println!(
+            "  skewness max {:.4} mean {:.4}; > 0.85: {}, > 0.9: {}",
+            q.skewness.max, q.skewness.mean, report.skew_above_085, report.skew_above_09
+        );
+        println!(
+            "  dihedral angles {:.2} .. {:.2} deg",
+            q.min_dihedral.min, q.max_dihedral.max
+        );
+    }
+    if !ok {
+        return Err(Error::InvalidMesh {
+            elements: vec![],
+            msg: format!(
+                "{} elements not certified valid, volume relative difference {rel:e}",
+                report.num_invalid
+            ),
+            mesh: None,
+        });
+    }
+    Ok(())
 }

@@ -14,8 +14,8 @@ mod repair;
 pub mod size;
 pub mod validity;
 
-use crate::geom::predicates::orient3d;
 use crate::geom::bezier::certify;
+use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::shape::{tri6_normal, TET10_EDGES};
 use crate::geom::vec3::*;
@@ -357,28 +357,49 @@ impl<'a> Mesher<'a> {
         let open = self.faces.iter().filter(|f| f.alive).count();
         if std::env::var_os("CURVETET_DEBUG3").is_some() {
             // For each live face, find faces sharing all of its edges pairwise -> tet cavities
-            let alive: Vec<u32> = (0..self.faces.len() as u32).filter(|&i| self.faces[i as usize].alive).collect();
+            let alive: Vec<u32> = (0..self.faces.len() as u32)
+                .filter(|&i| self.faces[i as usize].alive)
+                .collect();
             for &i in &alive {
                 let f = self.faces[i as usize];
                 // candidate 4th vertex: vertices of other alive faces sharing an edge
                 for &j in &alive {
-                    if i == j { continue; }
+                    if i == j {
+                        continue;
+                    }
                     let g = self.faces[j as usize];
                     let sh = g.v.iter().filter(|x| f.v.contains(x)).count();
                     if sh == 2 {
                         let p = *g.v.iter().find(|x| !f.v.contains(x)).unwrap();
                         // is there a 4-cavity?
                         let t = [f.v[0], f.v[1], f.v[2], p];
-                        let cnt = alive.iter().filter(|&&k| { let h = self.faces[k as usize].v; h.iter().all(|x| t.contains(x)) }).count();
+                        let cnt = alive
+                            .iter()
+                            .filter(|&&k| {
+                                let h = self.faces[k as usize].v;
+                                h.iter().all(|x| t.contains(x))
+                            })
+                            .count();
                         if cnt == 4 {
                             let tp = t.map(|x| self.pts[x as usize]);
-                            let near: Vec<FaceRef> = alive.iter().filter(|&&k| k != i).map(|&k| FaceRef { v: self.faces[k as usize].v }).collect();
+                            let near: Vec<FaceRef> = alive
+                                .iter()
+                                .filter(|&&k| k != i)
+                                .map(|&k| FaceRef {
+                                    v: self.faces[k as usize].v,
+                                })
+                                .collect();
                             let pts = &self.pts;
                             let v = validity::check(t, tp, &near, |x: u32| pts[x as usize]);
                             let w = validity::WHY.with(|w| w.borrow().clone());
                             let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
                             let o = orient3d(tp[0], tp[1], tp[2], tp[3]);
-                            let found = self.vtree.query(&tp[3]).within::<SquaredEuclidean<f64>>(1e-20).unsorted().execute();
+                            let found = self
+                                .vtree
+                                .query(&tp[3])
+                                .within::<SquaredEuclidean<f64>>(1e-20)
+                                .unsorted()
+                                .execute();
                             eprintln!("4-cavity {:?} orient {} valid {} ({}) curved {:?} in_tree {} found {} vdeg {} tries {}", t, o, v.is_some(), w, cur, self.in_tree[p as usize], found.len(), self.vdeg[p as usize], f.tries);
                             break;
                         }
@@ -391,7 +412,12 @@ impl<'a> Mesher<'a> {
             let mut w = std::fs::File::create(path).unwrap();
             for f in self.faces.iter().filter(|f| f.alive) {
                 let p = f.v.map(|x| self.pts[x as usize]);
-                writeln!(w, "{} {} {} {:?} {:?} {:?} {}", f.v[0], f.v[1], f.v[2], p[0], p[1], p[2], f.btri).unwrap();
+                writeln!(
+                    w,
+                    "{} {} {} {:?} {:?} {:?} {}",
+                    f.v[0], f.v[1], f.v[2], p[0], p[1], p[2], f.btri
+                )
+                .unwrap();
             }
         }
         Error::MeshingFailed {

@@ -42,11 +42,14 @@ mod msh_read;
 mod msh_types;
 mod msh_write;
 pub mod order;
+mod surface;
 mod text_out;
 mod vtk;
 mod vtk_cells;
 mod vtu;
 mod vtu_write;
+
+pub use surface::{read_surface, surface_from_raw};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
 pub const VOLUME_TAG: i32 = 1;

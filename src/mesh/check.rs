@@ -6,9 +6,9 @@
 
 use super::TetMesh;
 use crate::geom::predicates::orient3d;
+use crate::geom::quadrature::CompensatedSum;
 use crate::geom::shape::{TET10_EDGES, TRI6_EDGES};
 use crate::geom::vec3::{det3, sub, tet_det};
-use crate::geom::quadrature::CompensatedSum;
 use crate::{Error, Result};
 
 fn compensated_sum(xs: impl Iterator<Item = f64>) -> f64 {

@@ -22,3 +22,4 @@ pub struct TetMesh {
 
 pub mod build;
 pub mod check;
+pub mod quality;

@@ -24,6 +24,7 @@
 //!    a mixed one is an error.
 
 pub mod coords;
+pub mod demo;
 mod describe;
 mod exact_sum;
 pub mod geometry;
