@@ -6,6 +6,9 @@ use crate::front::{run_front, FrontStats};
 use crate::geom::quadrature::tri6_area;
 use crate::mesh::quality::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
+use crate::optimize::{
+    improve_linear, optimize_high_order, Boundary, HighOrderParams, LinearParams, OptimizeStats,
+};
 use crate::options::{Options, SizeMode};
 use crate::{Error, Result, Surface};
 use std::time::Instant;
@@ -38,6 +41,8 @@ pub struct Generated {
     pub front: FrontStats,
     /// Stage times.
     pub times: StageTimes,
+    /// What the optimization stages did (all zero when `Options::optimize` is off).
+    pub optimize: OptimizeStats,
     /// Target edge length used where the size is uniform (paper eq. 1 or the user's),
     /// or the smallest boundary size when graded.
     pub size: f64,
@@ -112,15 +117,35 @@ fn generate_inner(
     let front = run_front(surface.nodes(), surface.triangles(), opts, size, progress)?;
     times.front = t.elapsed().as_secs_f64();
 
+    let mut ostats = OptimizeStats::default();
+    let bnd = Boundary::new(surface.nodes().len(), surface.triangles());
+    let (pts, tets) = if opts.optimize {
+        let t = Instant::now();
+        let (pts, tets, st) = improve_linear(front.pts, front.tets, &bnd, &LinearParams::default());
+        ostats.linear = st;
+        ostats.time_linear = t.elapsed().as_secs_f64();
+        (pts, tets)
+    } else {
+        (front.pts, front.tets)
+    };
+
     let t = Instant::now();
-    let mesh = build::assemble(
-        &front.pts,
-        &front.tets,
+    let mut mesh = build::assemble(
+        &pts,
+        &tets,
         surface.nodes().len(),
         surface.triangles(),
         surface.tags(),
     );
     times.assemble = t.elapsed().as_secs_f64();
+
+    if opts.optimize {
+        let t = Instant::now();
+        ostats.high_order =
+            pool.install(|| optimize_high_order(&mut mesh, &bnd, &HighOrderParams::default()));
+        ostats.time_high_order = t.elapsed().as_secs_f64();
+    }
+    times.optimize = ostats.time_linear + ostats.time_high_order;
 
     if progress(1.0, "certify") {
         return Err(Error::Cancelled);
@@ -169,6 +194,7 @@ fn generate_inner(
         report,
         front: front.stats,
         times,
+        optimize: ostats,
         size: size_value,
     })
 }

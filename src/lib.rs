@@ -12,6 +12,7 @@ pub mod generate;
 pub mod geom;
 pub mod io;
 pub mod mesh;
+pub mod optimize;
 pub mod options;
 pub mod surface;
 

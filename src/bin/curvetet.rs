@@ -253,6 +253,7 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
             "report": r,
             "front": g.front,
             "times": g.times,
+            "optimize": g.optimize,
             "size": g.size,
         });
         let text = serde_json::to_string_pretty(&json)

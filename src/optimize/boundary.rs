@@ -1,0 +1,73 @@
+//! What the optimizer must keep: the surface nodes (the first `n_surf` points) and the
+//! boundary edges with their (possibly curved) mid nodes.
+
+use crate::geom::shape::{TET10_EDGES, TRI6_EDGES};
+use crate::geom::vec3::{mid, P3};
+use std::collections::HashMap;
+
+/// The boundary of the domain as the optimizer sees it.
+#[derive(Debug, Clone)]
+pub struct Boundary {
+    /// Points with an index below this are surface nodes: they never move.
+    pub n_surf: usize,
+    /// Boundary edge (smaller id, larger id) → its mid node (a surface node).
+    pub edge_mid: HashMap<(u32, u32), u32>,
+}
+
+impl Boundary {
+    /// The boundary of the closed P2 surface `tris` on the first `n_surf` points.
+    pub fn new(n_surf: usize, tris: &[[u32; 6]]) -> Boundary {
+        let mut edge_mid = HashMap::with_capacity(tris.len() * 3 / 2);
+        for t in tris {
+            for (k, [i, j]) in TRI6_EDGES.iter().enumerate() {
+                let (a, b) = (t[*i], t[*j]);
+                edge_mid.insert((a.min(b), a.max(b)), t[3 + k]);
+            }
+        }
+        Boundary { n_surf, edge_mid }
+    }
+
+    /// True for a surface node.
+    #[inline]
+    pub fn is_fixed(&self, v: u32) -> bool {
+        (v as usize) < self.n_surf
+    }
+
+    /// The mid node of `(a, b)` when it is a boundary edge.
+    #[inline]
+    pub fn edge_mid(&self, a: u32, b: u32) -> Option<u32> {
+        if self.is_fixed(a) && self.is_fixed(b) {
+            self.edge_mid.get(&(a.min(b), a.max(b))).copied()
+        } else {
+            None
+        }
+    }
+
+    /// True when `(a, b)` is an edge of a boundary triangle.
+    #[inline]
+    pub fn is_boundary_edge(&self, a: u32, b: u32) -> bool {
+        self.edge_mid(a, b).is_some()
+    }
+
+    /// The ten nodes of the P2 tet on corners `v` at positions `c`: boundary edges take
+    /// their mid nodes from `pts`, every other edge its midpoint. The flag says whether
+    /// some boundary mid node is off its chord midpoint (a curved tet).
+    #[inline]
+    pub fn tet10(&self, pts: &[P3], v: [u32; 4], c: &[P3; 4]) -> ([P3; 10], bool) {
+        let mut x = [[0.0; 3]; 10];
+        x[..4].copy_from_slice(c);
+        let mut curved = false;
+        for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
+            let m = mid(c[*i], c[*j]);
+            x[4 + k] = m;
+            if let Some(n) = self.edge_mid(v[*i], v[*j]) {
+                let p = pts[n as usize];
+                if p != m {
+                    x[4 + k] = p;
+                    curved = true;
+                }
+            }
+        }
+        (x, curved)
+    }
+}

@@ -1,0 +1,175 @@
+//! Edge contraction: an interior vertex `r` is merged into a neighbour `k` (which may be
+//! on the boundary; then `k` stays where it is, else `k` may move to `r`'s position or
+//! the edge midpoint). The tets of the edge disappear. The link condition keeps the mesh
+//! a manifold tiling; every new or moved tet must be positive (exact) and the minimum
+//! quality of the touched tets must rise.
+
+use super::mesh::LinMesh;
+use crate::geom::vec3::{mid, P3};
+
+/// Scratch buffers of the contraction.
+#[derive(Default)]
+pub(super) struct ContractScratch {
+    link_r: Vec<[u32; 3]>,
+    link_k: Vec<[u32; 3]>,
+    edges_r: Vec<[u32; 2]>,
+    edges_k: Vec<[u32; 2]>,
+    verts_r: Vec<u32>,
+    verts_k: Vec<u32>,
+    ring_e: Vec<[u32; 2]>,
+    ring_v: Vec<u32>,
+    touched: Vec<u32>,
+    new_tets: Vec<[u32; 4]>,
+}
+
+fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
+    f.sort_unstable();
+    f
+}
+
+fn sorted2(a: u32, b: u32) -> [u32; 2] {
+    [a.min(b), a.max(b)]
+}
+
+/// Link of vertex `v`: the faces opposite it, their edges and vertices (sorted, unique).
+fn link(m: &LinMesh, v: u32, f: &mut Vec<[u32; 3]>, e: &mut Vec<[u32; 2]>, p: &mut Vec<u32>) {
+    f.clear();
+    e.clear();
+    p.clear();
+    for &t in &m.vt[v as usize] {
+        let tv = m.tets[t as usize];
+        let mut o = [0u32; 3];
+        let mut k = 0;
+        for &x in &tv {
+            if x != v {
+                o[k] = x;
+                k += 1;
+            }
+        }
+        f.push(sorted3(o));
+        e.push(sorted2(o[0], o[1]));
+        e.push(sorted2(o[1], o[2]));
+        e.push(sorted2(o[0], o[2]));
+        p.extend_from_slice(&o);
+    }
+    f.sort_unstable();
+    f.dedup();
+    e.sort_unstable();
+    e.dedup();
+    p.sort_unstable();
+    p.dedup();
+}
+
+/// Count of common elements of two sorted slices.
+fn common<T: Ord>(a: &[T], b: &[T]) -> usize {
+    let (mut i, mut j, mut n) = (0, 0, 0);
+    while i < a.len() && j < b.len() {
+        match a[i].cmp(&b[j]) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => {
+                n += 1;
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    n
+}
+
+/// Try contracting the edge (r, k), removing the interior vertex `r`. Returns true when
+/// applied.
+pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut ContractScratch) -> bool {
+    if m.bnd.is_fixed(r) {
+        return false;
+    }
+    // Link condition: Lk(r) ∩ Lk(k) = Lk(rk) (triangles, edges, vertices).
+    link(m, r, &mut s.link_r, &mut s.edges_r, &mut s.verts_r);
+    link(m, k, &mut s.link_k, &mut s.edges_k, &mut s.verts_k);
+    s.ring_e.clear();
+    s.ring_v.clear();
+    for &t in &m.vt[r as usize] {
+        let tv = m.tets[t as usize];
+        if tv.contains(&k) {
+            let mut o = [0u32; 2];
+            let mut n = 0;
+            for &x in &tv {
+                if x != r && x != k {
+                    o[n] = x;
+                    n += 1;
+                }
+            }
+            s.ring_e.push(sorted2(o[0], o[1]));
+            s.ring_v.extend_from_slice(&o);
+        }
+    }
+    if s.ring_e.is_empty() {
+        return false; // not an edge
+    }
+    s.ring_e.sort_unstable();
+    s.ring_e.dedup();
+    s.ring_v.sort_unstable();
+    s.ring_v.dedup();
+    if common(&s.link_r, &s.link_k) != 0
+        || common(&s.edges_r, &s.edges_k) != s.ring_e.len()
+        || common(&s.verts_r, &s.verts_k) != s.ring_v.len()
+    {
+        return false;
+    }
+    // Tets touched: star(r) ∪ star(k).
+    s.touched.clear();
+    s.touched.extend_from_slice(&m.vt[r as usize]);
+    s.touched.extend_from_slice(&m.vt[k as usize]);
+    s.touched.sort_unstable();
+    s.touched.dedup();
+    let old = s
+        .touched
+        .iter()
+        .map(|&t| m.q[t as usize])
+        .fold(f64::INFINITY, f64::min);
+    let (pr, pk) = (m.pts[r as usize], m.pts[k as usize]);
+    let mut cands: [Option<P3>; 3] = [Some(pk), None, None];
+    if !m.bnd.is_fixed(k) {
+        cands[1] = Some(mid(pr, pk));
+        cands[2] = Some(pr);
+    }
+    let mut best: Option<(f64, P3)> = None;
+    for p in cands.into_iter().flatten() {
+        let mut worst = f64::INFINITY;
+        for &t in &s.touched {
+            let tv = m.tets[t as usize];
+            if tv.contains(&r) && tv.contains(&k) {
+                continue;
+            }
+            let nv = tv.map(|x| if x == r { k } else { x });
+            let c = nv.map(|x| if x == k { p } else { m.pts[x as usize] });
+            worst = worst.min(m.quality_at(nv, &c));
+            if worst <= old + eps || best.is_some_and(|b| worst <= b.0) {
+                break;
+            }
+        }
+        if worst > old + eps && best.map_or(true, |b| worst > b.0) {
+            best = Some((worst, p));
+        }
+    }
+    let Some((_, p)) = best else {
+        return false;
+    };
+    m.pts[k as usize] = p;
+    s.new_tets.clear();
+    for &t in &s.touched {
+        let tv = m.tets[t as usize];
+        if !(tv.contains(&r) && tv.contains(&k)) {
+            s.new_tets.push(tv.map(|x| if x == r { k } else { x }));
+        }
+    }
+    for &t in &s.touched {
+        m.remove(t);
+    }
+    for i in 0..s.new_tets.len() {
+        let v = s.new_tets[i];
+        let q = m.quality(v);
+        m.add(v, q);
+    }
+    true
+}

@@ -1,0 +1,210 @@
+//! A mutable straight-sided tet mesh with vertex → tet incidence: what the local
+//! operations of the linear stage edit.
+
+use super::quality::ElementQuality;
+use crate::geom::vec3::P3;
+use crate::optimize::Boundary;
+
+/// Marker of a deleted tet slot.
+pub(super) const DEAD: [u32; 4] = [u32::MAX; 4];
+
+/// Tets (positive corner order) with cached qualities and vertex stars.
+pub(super) struct LinMesh<'a> {
+    /// Point positions (surface nodes first; only interior ones ever change).
+    pub pts: Vec<P3>,
+    /// Tets; deleted slots hold [`DEAD`].
+    pub tets: Vec<[u32; 4]>,
+    /// Cached quality of each live tet.
+    pub q: Vec<f64>,
+    /// Tets incident to each point.
+    pub vt: Vec<Vec<u32>>,
+    /// The fixed boundary.
+    pub bnd: &'a Boundary,
+    /// The element quality measure.
+    pub eq: ElementQuality,
+    /// Deleted slots, reused by [`LinMesh::add`] (last freed first).
+    free: Vec<u32>,
+}
+
+impl<'a> LinMesh<'a> {
+    /// Build from the front's output.
+    pub fn new(pts: Vec<P3>, tets: Vec<[u32; 4]>, bnd: &'a Boundary, eq: ElementQuality) -> Self {
+        let mut vt = vec![Vec::new(); pts.len()];
+        for (i, t) in tets.iter().enumerate() {
+            for &v in t {
+                vt[v as usize].push(i as u32);
+            }
+        }
+        let mut m = LinMesh {
+            pts,
+            q: vec![0.0; tets.len()],
+            tets,
+            vt,
+            bnd,
+            eq,
+            free: Vec::new(),
+        };
+        for i in 0..m.tets.len() {
+            m.q[i] = m.quality(m.tets[i]);
+        }
+        m
+    }
+
+    /// Corner positions of `v`.
+    #[inline]
+    pub fn corners(&self, v: [u32; 4]) -> [P3; 4] {
+        v.map(|i| self.pts[i as usize])
+    }
+
+    /// Quality of the tet on `v` at the current positions.
+    #[inline]
+    pub fn quality(&self, v: [u32; 4]) -> f64 {
+        self.quality_at(v, &self.corners(v))
+    }
+
+    /// Quality of the tet on `v` with corners at `c`.
+    #[inline]
+    pub fn quality_at(&self, v: [u32; 4], c: &[P3; 4]) -> f64 {
+        self.eq.eval(self.bnd, &self.pts, v, c)
+    }
+
+    /// True for a live tet slot.
+    #[inline]
+    pub fn alive(&self, t: u32) -> bool {
+        self.tets[t as usize][0] != u32::MAX
+    }
+
+    /// Insert a tet with known quality; returns its slot.
+    pub fn add(&mut self, v: [u32; 4], q: f64) -> u32 {
+        let t = if let Some(t) = self.free.pop() {
+            self.tets[t as usize] = v;
+            self.q[t as usize] = q;
+            t
+        } else {
+            self.tets.push(v);
+            self.q.push(q);
+            (self.tets.len() - 1) as u32
+        };
+        for &x in &v {
+            self.vt[x as usize].push(t);
+        }
+        t
+    }
+
+    /// Delete tet `t`.
+    pub fn remove(&mut self, t: u32) {
+        let v = self.tets[t as usize];
+        for &x in &v {
+            let s = &mut self.vt[x as usize];
+            if let Some(i) = s.iter().position(|&y| y == t) {
+                s.swap_remove(i);
+            }
+        }
+        self.tets[t as usize] = DEAD;
+        self.q[t as usize] = f64::INFINITY;
+        self.free.push(t);
+    }
+
+    /// The live tets containing both `a` and `b`, appended to `out` (cleared first).
+    pub fn edge_tets(&self, a: u32, b: u32, out: &mut Vec<u32>) {
+        out.clear();
+        for &t in &self.vt[a as usize] {
+            if self.tets[t as usize].contains(&b) {
+                out.push(t);
+            }
+        }
+    }
+
+    /// The tet other than `t` that has face `f`, if any.
+    pub fn across(&self, t: u32, f: [u32; 3]) -> Option<u32> {
+        self.vt[f[0] as usize].iter().copied().find(|&s| {
+            s != t && {
+                let x = &self.tets[s as usize];
+                x.contains(&f[1]) && x.contains(&f[2])
+            }
+        })
+    }
+
+    /// The live tets and the points in use, compacted in slot order.
+    pub fn into_parts(self) -> (Vec<P3>, Vec<[u32; 4]>) {
+        let tets = self.tets.into_iter().filter(|t| t[0] != u32::MAX).collect();
+        (self.pts, tets)
+    }
+}
+
+/// The two corners of `t` other than `a` and `b`, ordered so that (a, b, u, v) is an even
+/// permutation of `t` (so positive when `t` is).
+#[inline]
+pub(super) fn opposite_edge(t: [u32; 4], a: u32, b: u32) -> (u32, u32) {
+    let ia = t.iter().position(|&x| x == a).unwrap_or(0);
+    let ib = t.iter().position(|&x| x == b).unwrap_or(1);
+    let mut rest = [0usize; 2];
+    let mut k = 0;
+    for i in 0..4 {
+        if i != ia && i != ib {
+            rest[k] = i;
+            k += 1;
+        }
+    }
+    let p = [ia, ib, rest[0], rest[1]];
+    let mut inv = 0;
+    for i in 0..4 {
+        for j in i + 1..4 {
+            if p[i] > p[j] {
+                inv += 1;
+            }
+        }
+    }
+    if inv % 2 == 0 {
+        (t[rest[0]], t[rest[1]])
+    } else {
+        (t[rest[1]], t[rest[0]])
+    }
+}
+
+/// The face of `t` opposite corner `k`, ordered so that (f0, f1, f2, t[k]) is positive
+/// when `t` is.
+#[inline]
+pub(super) fn face_opposite(t: [u32; 4], k: usize) -> [u32; 3] {
+    match k {
+        0 => [t[2], t[1], t[3]],
+        1 => [t[0], t[2], t[3]],
+        2 => [t[1], t[0], t[3]],
+        _ => [t[0], t[1], t[2]],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parity(p: [u32; 4], t: [u32; 4]) -> bool {
+        let idx = p.map(|x| t.iter().position(|&y| y == x).unwrap());
+        let mut inv = 0;
+        for i in 0..4 {
+            for j in i + 1..4 {
+                if idx[i] > idx[j] {
+                    inv += 1;
+                }
+            }
+        }
+        inv % 2 == 0
+    }
+
+    #[test]
+    fn orderings_are_even_permutations() {
+        let t = [10, 11, 12, 13];
+        for k in 0..4 {
+            let f = face_opposite(t, k);
+            assert!(parity([f[0], f[1], f[2], t[k]], t), "face {k}");
+        }
+        for a in 0..4 {
+            for b in 0..4 {
+                if a != b {
+                    let (u, v) = opposite_edge(t, t[a], t[b]);
+                    assert!(parity([t[a], t[b], u, v], t));
+                }
+            }
+        }
+    }
+}

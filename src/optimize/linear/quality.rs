@@ -1,0 +1,114 @@
+//! The element quality the linear stage maximizes (the minimum of, over the elements an
+//! operation touches): 1 − equiangular skewness (paper eq. 2) of the corner tet, in
+//! [0, 1], for a tet that is positive (exact) and, when it touches a curved boundary edge,
+//! certified valid as a P2 element. A positive tet that is not P2-valid scores in
+//! [−1, −0.5] by its scaled-Jacobian lower bound (so operations may improve it but never
+//! create one); a non-positive tet scores −∞.
+
+use crate::geom::bezier::{certify, jacobian_bounds};
+use crate::geom::predicates::orient3d;
+use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG};
+use crate::geom::vec3::P3;
+use crate::optimize::dual::{dcross, ddot, dsub, D3, DP};
+use crate::optimize::Boundary;
+
+/// The quality measure of the linear stage (see the module docs).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ElementQuality;
+
+impl ElementQuality {
+    /// Quality of the tet on vertex ids `v` with corner positions `c` (`pts` gives the
+    /// boundary mid nodes).
+    #[inline]
+    pub fn eval(&self, bnd: &Boundary, pts: &[P3], v: [u32; 4], c: &[P3; 4]) -> f64 {
+        if orient3d(c[0], c[1], c[2], c[3]) <= 0 {
+            return f64::NEG_INFINITY;
+        }
+        let (lo, hi) = dihedral_extremes(c);
+        let s = skewness_from_extremes(lo, hi);
+        if !s.is_finite() {
+            return f64::NEG_INFINITY;
+        }
+        let nb = v.iter().filter(|&&x| bnd.is_fixed(x)).count();
+        if nb >= 2 {
+            let (x, curved) = bnd.tet10(pts, v, c);
+            if curved && !certify(&x).is_valid() {
+                let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
+                let sj = if sj.is_nan() { -1.0 } else { sj.clamp(-1.0, 0.0) };
+                return -1.0 + 0.5 * (1.0 + sj);
+            }
+        }
+        1.0 - s
+    }
+}
+
+/// The twelve smooth pieces whose minimum is 1 − skewness: for each dihedral angle θ
+/// (degrees), θ/θe and (180 − θ)/(180 − θe); with their gradients with respect to corner
+/// `k` of `c`.
+pub(super) fn skew_pieces(c: &[P3; 4], k: usize) -> [D3; 12] {
+    let p: [DP; 4] = std::array::from_fn(|i| {
+        std::array::from_fn(|d| {
+            if i == k {
+                D3::var(c[i][d], d)
+            } else {
+                D3::c(c[i][d])
+            }
+        })
+    });
+    // Outward normals of the faces opposite corners 0..3 (as in geom::quality).
+    let n = |a: usize, b: usize, d: usize| dcross(dsub(p[b], p[a]), dsub(p[d], p[a]));
+    let normals = [n(1, 2, 3), n(0, 3, 2), n(0, 1, 3), n(0, 2, 1)];
+    let te = EQUIANGULAR_DIHEDRAL_DEG;
+    let mut out = [D3::c(0.0); 12];
+    for (e, [a, b]) in crate::geom::shape::TET10_EDGES.iter().enumerate() {
+        let mut other = [0usize; 2];
+        let mut m = 0;
+        for v in 0..4 {
+            if v != *a && v != *b {
+                other[m] = v;
+                m += 1;
+            }
+        }
+        let (na, nb) = (normals[other[0]], normals[other[1]]);
+        let x = dcross(na, nb);
+        let s = ddot(x, x).sqrt();
+        let cs = -ddot(na, nb);
+        let theta = s.atan2(cs).scale(180.0 / std::f64::consts::PI);
+        out[2 * e] = theta.scale(1.0 / te);
+        out[2 * e + 1] = (D3::c(180.0) - theta).scale(1.0 / (180.0 - te));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::quality::{dihedral_angles, equiangular_skewness};
+
+    #[test]
+    fn pieces_give_one_minus_skewness_and_their_gradients() {
+        let c = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [0.2, 0.9, 0.1],
+            [0.3, 0.2, 0.7],
+        ];
+        let s = equiangular_skewness(&dihedral_angles(&c));
+        for k in 0..4 {
+            let p = skew_pieces(&c, k);
+            let m = p.iter().map(|x| x.v).fold(f64::INFINITY, f64::min);
+            assert!((m - (1.0 - s)).abs() < 1e-12);
+            for (i, piece) in p.iter().enumerate() {
+                for d in 0..3 {
+                    let h = 1e-6;
+                    let mut cp = c;
+                    cp[k][d] += h;
+                    let mut cm = c;
+                    cm[k][d] -= h;
+                    let fd = (skew_pieces(&cp, k)[i].v - skew_pieces(&cm, k)[i].v) / (2.0 * h);
+                    assert!((fd - piece.g[d]).abs() < 1e-6, "{k} {i} {d}");
+                }
+            }
+        }
+    }
+}

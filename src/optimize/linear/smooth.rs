@@ -1,0 +1,196 @@
+//! Optimization-based smoothing of one interior vertex: maximize the minimum quality of
+//! its star (a non-smooth max-min problem) by the active-set method of Freitag and
+//! Ollivier-Gooch: the search direction is the minimum-norm point of the convex hull of
+//! the gradients of the (nearly) active quality pieces, followed by a backtracking line
+//! search that accepts only a strict rise of the minimum with every tet still valid.
+//! Boundary vertices are never moved.
+
+use super::mesh::LinMesh;
+use super::quality::skew_pieces;
+use crate::geom::vec3::{dist, dot, norm, P3};
+
+/// Tuning of the smoother.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SmoothParams {
+    /// Most line searches per call.
+    pub max_iter: usize,
+    /// Pieces within this of the minimum are active.
+    pub active_tol: f64,
+    /// Halvings of the step before giving up.
+    pub max_halvings: usize,
+    /// The minimum must rise by more than this.
+    pub eps: f64,
+}
+
+impl Default for SmoothParams {
+    fn default() -> Self {
+        SmoothParams {
+            max_iter: 12,
+            active_tol: 1e-3,
+            max_halvings: 10,
+            eps: 1e-9,
+        }
+    }
+}
+
+/// Scratch buffers of the smoother.
+#[derive(Default)]
+pub(super) struct SmoothScratch {
+    star: Vec<u32>,
+    grads: Vec<[f64; 3]>,
+    vals: Vec<(f64, [f64; 3])>,
+}
+
+/// Minimum-norm point of the convex hull of `g` (Gilbert's algorithm; few points).
+fn min_norm_point(g: &[[f64; 3]]) -> [f64; 3] {
+    let mut x = g[0];
+    for _ in 0..64 {
+        // The hull point minimizing x . g_j.
+        let mut j = 0;
+        let mut best = f64::INFINITY;
+        for (i, gi) in g.iter().enumerate() {
+            let v = dot(x, *gi);
+            if v < best {
+                best = v;
+                j = i;
+            }
+        }
+        let xx = dot(x, x);
+        if xx - best <= 1e-12 * xx.max(1e-300) {
+            break;
+        }
+        let d = [g[j][0] - x[0], g[j][1] - x[1], g[j][2] - x[2]];
+        let dd = dot(d, d);
+        if dd <= 0.0 {
+            break;
+        }
+        let t = (-dot(x, d) / dd).clamp(0.0, 1.0);
+        x = [x[0] + t * d[0], x[1] + t * d[1], x[2] + t * d[2]];
+    }
+    x
+}
+
+/// Minimum quality of the star of `v` with `v` at `p`; stops early (returning a value
+/// <= `floor`) as soon as some tet is not above `floor`.
+fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64) -> f64 {
+    let mut lo = f64::INFINITY;
+    for &t in star {
+        let tv = m.tets[t as usize];
+        let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
+        let q = m.quality_at(tv, &c);
+        lo = lo.min(q);
+        if lo <= floor {
+            break;
+        }
+    }
+    lo
+}
+
+/// Smooth interior vertex `v`; returns true when it moved.
+pub(super) fn smooth_vertex(
+    m: &mut LinMesh,
+    v: u32,
+    prm: &SmoothParams,
+    s: &mut SmoothScratch,
+) -> bool {
+    if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() {
+        return false;
+    }
+    s.star.clear();
+    s.star.extend_from_slice(&m.vt[v as usize]);
+    let mut p = m.pts[v as usize];
+    // Largest step: a third of the shortest edge at v.
+    let mut min_len = f64::INFINITY;
+    for &t in &s.star {
+        for &x in &m.tets[t as usize] {
+            if x != v {
+                min_len = min_len.min(dist(p, m.pts[x as usize]));
+            }
+        }
+    }
+    let max_move = min_len / 3.0;
+    let mut qmin = s
+        .star
+        .iter()
+        .map(|&t| m.q[t as usize])
+        .fold(f64::INFINITY, f64::min);
+    let mut moved = false;
+    for _ in 0..prm.max_iter {
+        // Active pieces and their gradients.
+        s.grads.clear();
+        s.vals.clear();
+        for &t in &s.star {
+            let tv = m.tets[t as usize];
+            let k = tv.iter().position(|&x| x == v).unwrap_or(0);
+            let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
+            let qt = m.q[t as usize];
+            if qt > qmin + prm.active_tol {
+                // Far from active: only its first-order behaviour matters for the step.
+                continue;
+            }
+            if qt < 0.0 {
+                // P2-invalid (curved) tet: finite-difference gradient of its score.
+                let h = 1e-6 * min_len;
+                let mut g = [0.0; 3];
+                for (d, gd) in g.iter_mut().enumerate() {
+                    let mut cp = c;
+                    cp[k][d] += h;
+                    let mut cm = c;
+                    cm[k][d] -= h;
+                    *gd = (m.quality_at(tv, &cp) - m.quality_at(tv, &cm)) / (2.0 * h);
+                }
+                s.grads.push(g);
+                continue;
+            }
+            for piece in skew_pieces(&c, k) {
+                if piece.v <= qmin + prm.active_tol {
+                    s.grads.push(piece.g);
+                }
+            }
+        }
+        if s.grads.is_empty() {
+            break;
+        }
+        let d = min_norm_point(&s.grads);
+        let dn = norm(d);
+        if !(dn > 0.0) || !dn.is_finite() {
+            break;
+        }
+        let mut alpha = max_move / dn;
+        let mut accepted = false;
+        for _ in 0..prm.max_halvings {
+            let np = [p[0] + alpha * d[0], p[1] + alpha * d[1], p[2] + alpha * d[2]];
+            let nq = star_min(m, v, &s.star, np, qmin + prm.eps);
+            if nq > qmin + prm.eps {
+                p = np;
+                qmin = nq;
+                accepted = true;
+                break;
+            }
+            alpha *= 0.5;
+        }
+        if !accepted {
+            break;
+        }
+        moved = true;
+        m.pts[v as usize] = p;
+        for i in 0..s.star.len() {
+            let t = s.star[i];
+            m.q[t as usize] = m.quality(m.tets[t as usize]);
+        }
+    }
+    moved
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_norm_point_of_a_segment_and_a_triangle() {
+        let x = min_norm_point(&[[1.0, 1.0, 0.0], [1.0, -1.0, 0.0]]);
+        assert!((x[0] - 1.0).abs() < 1e-9 && x[1].abs() < 1e-9);
+        let x = min_norm_point(&[[1.0, 0.0, 0.0], [-1.0, 1.0, 0.0], [-1.0, -1.0, 0.0]]);
+        assert!(norm(x) < 1e-6, "{x:?}");
+    }
+}
