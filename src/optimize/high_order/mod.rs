@@ -1,17 +1,319 @@
-//! High-order node optimization (placeholder).
+//! High-order node optimization of the assembled P2 mesh.
+//!
+//! Seeds are the elements whose certified min J / max J is below a threshold, worst
+//! first. Around each a patch is built ([`patch`]); patches are coloured so that those of
+//! one colour share no active element, and the patches of a colour are optimized in
+//! parallel, each by a sequence of L-BFGS runs on the log-barrier objective
+//! ([`objective`]) with the barrier moved up to just below the current minimum after each
+//! run (Gmsh's moving barrier; it starts from any state, including invalid elements).
+//! A patch's result is kept only when the certified minimum min J / max J of its active
+//! elements rose (and, if vertices moved, their skewness stayed within bounds); results
+//! are written back in patch order, so the output does not depend on the thread count.
+//! Surface nodes are never variables.
 
+mod jacobian;
+mod lbfgs;
+mod objective;
+mod patch;
+
+use crate::geom::bezier::scaled_jacobian_certified;
+use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, DEFAULT_SJ_REL_TOL};
+use crate::geom::vec3::{dist, mid, P3};
+use crate::mesh::quality::tet_nodes;
 use crate::mesh::TetMesh;
 use crate::optimize::Boundary;
+use lbfgs::Lbfgs;
+use objective::{nodes, Objective, PatchElem, FIXED};
+use patch::{colour, Marks, NodeElems, Patch};
+use rayon::prelude::*;
 
 /// Tuning of the high-order stage.
-#[derive(Clone, Debug, Default)]
-pub struct HighOrderParams {}
+#[derive(Clone, Debug)]
+pub struct HighOrderParams {
+    /// Elements with certified min J / max J below this seed patches.
+    pub threshold: f64,
+    /// Vertex-neighbour rings around a seed in its patch (round r uses `layers + r`).
+    pub layers: usize,
+    /// Rounds of (seed, patch, optimize).
+    pub rounds: usize,
+    /// Let interior vertices move too (their edges' mid nodes follow them).
+    pub move_vertices: bool,
+    /// Largest corner skewness moving vertices may create (a patch already worse may
+    /// not get worse).
+    pub max_skewness: f64,
+    /// Barrier updates per patch.
+    pub barrier_updates: usize,
+    /// L-BFGS iterations per barrier.
+    pub iterations: usize,
+}
+
+impl Default for HighOrderParams {
+    fn default() -> Self {
+        HighOrderParams {
+            threshold: 0.9,
+            layers: 1,
+            rounds: 3,
+            move_vertices: true,
+            max_skewness: 0.7,
+            barrier_updates: 8,
+            iterations: 40,
+        }
+    }
+}
 
 /// What the high-order stage did.
 #[derive(Debug, Clone, Default, serde::Serialize)]
-pub struct HighOrderStats {}
+pub struct HighOrderStats {
+    /// Certified min of min J / max J over the mesh, before and after.
+    pub min_scaled_jacobian: [f64; 2],
+    /// Elements not certified valid, before and after.
+    pub invalid: [usize; 2],
+    /// Elements below the threshold, before and after.
+    pub below_threshold: [usize; 2],
+    /// Rounds made.
+    pub rounds: usize,
+    /// Patches optimized.
+    pub patches: usize,
+    /// Patches whose result was kept.
+    pub patches_improved: usize,
+    /// Elements whose certified min J / max J rose.
+    pub elements_improved: usize,
+}
 
-/// Optimize the free nodes of `mesh`.
-pub fn optimize_high_order(_mesh: &mut TetMesh, _bnd: &Boundary, _prm: &HighOrderParams) -> HighOrderStats {
-    HighOrderStats {}
+/// Certified min J / max J of element `t`.
+#[inline]
+fn element_sj(mesh: &TetMesh, t: usize) -> f64 {
+    let v = scaled_jacobian_certified(&tet_nodes(mesh, t), DEFAULT_SJ_REL_TOL);
+    if v.is_nan() {
+        -1.0
+    } else {
+        v
+    }
+}
+
+/// Optimize the free nodes of `mesh` (every node at index >= `bnd.n_surf`). Runs on the
+/// current rayon pool; the result is the same for any number of threads.
+pub fn optimize_high_order(mesh: &mut TetMesh, bnd: &Boundary, prm: &HighOrderParams) -> HighOrderStats {
+    let mut st = HighOrderStats::default();
+    let ne = mesh.tets.len();
+    let mut sj: Vec<f64> = (0..ne).into_par_iter().map(|t| element_sj(mesh, t)).collect();
+    let sj_start = sj.clone();
+    let census = |sj: &[f64]| {
+        let min = sj.iter().copied().fold(f64::INFINITY, f64::min);
+        let invalid = sj.iter().filter(|&&v| !(v > 0.0)).count();
+        let below = sj.iter().filter(|&&v| v < prm.threshold).count();
+        (min, invalid, below)
+    };
+    let (m0, i0, b0) = census(&sj);
+    st.min_scaled_jacobian[0] = if ne == 0 { 1.0 } else { m0 };
+    st.invalid[0] = i0;
+    st.below_threshold[0] = b0;
+    let adj = NodeElems::new(mesh);
+    let mut marks = Marks::new(ne, mesh.nodes.len());
+    for round in 0..prm.rounds {
+        let mut seeds: Vec<u32> = (0..ne as u32)
+            .filter(|&t| sj[t as usize] < prm.threshold)
+            .collect();
+        if seeds.is_empty() {
+            break;
+        }
+        st.rounds += 1;
+        seeds.sort_by(|&a, &b| sj[a as usize].total_cmp(&sj[b as usize]).then(a.cmp(&b)));
+        // One patch per seed not already inside an earlier patch of this round.
+        let mut covered = vec![false; ne];
+        let mut patches: Vec<Patch> = Vec::new();
+        for &s in &seeds {
+            if covered[s as usize] {
+                continue;
+            }
+            let p = patch::build(
+                mesh,
+                &adj,
+                bnd.n_surf,
+                s,
+                prm.layers + round,
+                prm.move_vertices,
+                &mut marks,
+            );
+            if p.free.is_empty() {
+                continue;
+            }
+            // Seeds all of whose non-surface nodes are free here are covered.
+            for &e in &p.elems {
+                let all_free = mesh.tets[e as usize]
+                    .iter()
+                    .all(|&n| (n as usize) < bnd.n_surf || p.free.binary_search(&n).is_ok() || (!prm.move_vertices && adj.is_vertex[n as usize]));
+                if all_free {
+                    covered[e as usize] = true;
+                }
+            }
+            patches.push(p);
+        }
+        let colours = colour(&patches, ne);
+        let ncol = colours.iter().copied().max().map_or(0, |c| c + 1);
+        let mut improved_round = 0;
+        for c in 0..ncol {
+            let batch: Vec<usize> = (0..patches.len()).filter(|&i| colours[i] == c).collect();
+            if batch.is_empty() {
+                continue;
+            }
+            let nodes_now = &mesh.nodes;
+            let results: Vec<Option<PatchResult>> = batch
+                .par_iter()
+                .map(|&i| {
+                    let mut lb = Lbfgs::default();
+                    optimize_patch(mesh, nodes_now, &patches[i], &sj, prm, &mut lb)
+                })
+                .collect();
+            st.patches += batch.len();
+            for (&i, r) in batch.iter().zip(results) {
+                let Some(r) = r else { continue };
+                st.patches_improved += 1;
+                improved_round += 1;
+                for (n, p) in patches[i].free.iter().zip(r.positions) {
+                    mesh.nodes[*n as usize] = p;
+                }
+                for (e, v) in patches[i].elems.iter().zip(r.sj) {
+                    sj[*e as usize] = v;
+                }
+            }
+        }
+        if improved_round == 0 {
+            break;
+        }
+    }
+    let (m1, i1, b1) = census(&sj);
+    st.min_scaled_jacobian[1] = if ne == 0 { 1.0 } else { m1 };
+    st.invalid[1] = i1;
+    st.below_threshold[1] = b1;
+    st.elements_improved = sj.iter().zip(&sj_start).filter(|(a, b)| a > b).count();
+    st
+}
+
+/// The outcome of a patch whose optimization is kept.
+struct PatchResult {
+    /// New position of each free node (patch order).
+    positions: Vec<P3>,
+    /// New certified min J / max J of each active element (patch order).
+    sj: Vec<f64>,
+}
+
+/// Optimize one patch against the node positions `x`; `None` when nothing improved.
+fn optimize_patch(
+    mesh: &TetMesh,
+    x: &[P3],
+    p: &Patch,
+    sj: &[f64],
+    prm: &HighOrderParams,
+    lb: &mut Lbfgs,
+) -> Option<PatchResult> {
+    let var_of = |n: u32| -> u32 { p.free.binary_search(&n).map_or(FIXED, |i| i as u32) };
+    let mut elems = Vec::with_capacity(p.elems.len());
+    let mut h = 0.0;
+    let mut before_min = f64::INFINITY;
+    let mut before_skew = 0.0f64;
+    let mut moves_vertex = false;
+    for &e in &p.elems {
+        let t = &mesh.tets[e as usize];
+        let xe: [P3; 10] = std::array::from_fn(|k| x[t[k] as usize]);
+        let var = t.map(var_of);
+        moves_vertex |= var[..4].iter().any(|&v| v != FIXED);
+        h += dist(xe[0], xe[1]);
+        before_min = before_min.min(sj[e as usize]);
+        before_skew = before_skew.max(skew(&xe));
+        elems.push(PatchElem { x: xe, var });
+    }
+    h /= p.elems.len().max(1) as f64;
+    // Initial variables: vertex positions, mid offsets from their edge midpoints.
+    let mut v = vec![0.0; 3 * p.free.len()];
+    let mut set = vec![false; p.free.len()];
+    for el in &elems {
+        for k in 0..10 {
+            let i = el.var[k];
+            if i == FIXED || set[i as usize] {
+                continue;
+            }
+            let i = i as usize;
+            let val = if k < 4 {
+                el.x[k]
+            } else {
+                let [a, b] = crate::geom::shape::TET10_EDGES[k - 4];
+                let m = mid(el.x[a], el.x[b]);
+                [el.x[k][0] - m[0], el.x[k][1] - m[1], el.x[k][2] - m[2]]
+            };
+            v[3 * i..3 * i + 3].copy_from_slice(&val);
+            set[i] = true;
+        }
+    }
+    let mut obj = Objective {
+        elems: &elems,
+        eps: 0.0,
+    };
+    let mut mmin = obj.min_measure(&v);
+    if !mmin.is_finite() || mmin >= 1.0 {
+        return None;
+    }
+    let v0 = v.clone();
+    for _ in 0..prm.barrier_updates {
+        obj.eps = if mmin == 0.0 {
+            -0.1
+        } else {
+            mmin - 0.1 * mmin.abs()
+        };
+        let mut f = |v: &[f64], g: &mut [f64]| obj.eval(v, g);
+        lb.minimize(&mut v, &mut f, prm.iterations, 0.02 * h);
+        let new = obj.min_measure(&v);
+        let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
+        mmin = new;
+        if stagnated {
+            break;
+        }
+    }
+    if v == v0 {
+        return None;
+    }
+    // Certify and compare.
+    let mut after = Vec::with_capacity(elems.len());
+    let mut after_min = f64::INFINITY;
+    let mut after_skew = 0.0f64;
+    for el in &elems {
+        let xe = nodes(el, &v);
+        let s = scaled_jacobian_certified(&xe, DEFAULT_SJ_REL_TOL);
+        let s = if s.is_nan() { -1.0 } else { s };
+        after_min = after_min.min(s);
+        if moves_vertex {
+            after_skew = after_skew.max(skew(&xe));
+        }
+        after.push(s);
+    }
+    if !(after_min > before_min) {
+        return None;
+    }
+    if moves_vertex && after_skew > before_skew.max(prm.max_skewness) {
+        return None;
+    }
+    // Final free node positions.
+    let mut pos = vec![[0.0; 3]; p.free.len()];
+    let mut done = vec![false; p.free.len()];
+    for el in &elems {
+        let xe = nodes(el, &v);
+        for k in 0..10 {
+            let i = el.var[k];
+            if i != FIXED && !done[i as usize] {
+                pos[i as usize] = xe[k];
+                done[i as usize] = true;
+            }
+        }
+    }
+    Some(PatchResult {
+        positions: pos,
+        sj: after,
+    })
+}
+
+/// Equiangular skewness of the corner tet.
+#[inline]
+fn skew(x: &[P3; 10]) -> f64 {
+    let (lo, hi) = dihedral_extremes(&[x[0], x[1], x[2], x[3]]);
+    skewness_from_extremes(lo, hi)
 }

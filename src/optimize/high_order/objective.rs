@@ -1,0 +1,189 @@
+//! The objective of one patch: for every element with a free node and every Bernstein
+//! coefficient `b_s` of its det J, the measure `m_s = b_s / mean(b)` (1 for every
+//! coefficient of a straight-sided tet; the certified min J / max J is at least
+//! min m / max m) enters Gmsh's log-barrier function
+//! `f(m) = (m − 1)² + ln²((m − ε) / (1 − ε))`, +∞ for m ≤ ε, with ε below the current
+//! minimum (moved up between runs by the caller).
+//!
+//! Variables: each free vertex's position, and for each free mid node its offset from
+//! its edge's midpoint (so a mid node follows its moving corners).
+
+use super::jacobian::{backprop, bezier_forward};
+use crate::geom::vec3::{mid, P3};
+
+/// No variable.
+pub(super) const FIXED: u32 = u32::MAX;
+
+/// One element of a patch: the fixed node positions and, per node, its variable.
+#[derive(Clone, Debug)]
+pub(super) struct PatchElem {
+    /// Positions of the fixed nodes (free ones are ignored).
+    pub x: [P3; 10],
+    /// Variable of each node ([`FIXED`] when fixed); corners 0..4 are positions, mids
+    /// 4..10 offsets from their edge midpoint.
+    pub var: [u32; 10],
+}
+
+/// The elements of a patch and the barrier.
+pub(super) struct Objective<'a> {
+    /// The patch's elements that have a free node.
+    pub elems: &'a [PatchElem],
+    /// Barrier ε: the objective is +∞ where some measure is ≤ ε.
+    pub eps: f64,
+}
+
+/// The nodes of `e` for variables `v`.
+#[inline]
+pub(super) fn nodes(e: &PatchElem, v: &[f64]) -> [P3; 10] {
+    let mut x = e.x;
+    for k in 0..4 {
+        let i = e.var[k];
+        if i != FIXED {
+            let i = 3 * i as usize;
+            x[k] = [v[i], v[i + 1], v[i + 2]];
+        }
+    }
+    for (k, [a, b]) in crate::geom::shape::TET10_EDGES.iter().enumerate() {
+        let i = e.var[4 + k];
+        if i != FIXED {
+            let i = 3 * i as usize;
+            let m = mid(x[*a], x[*b]);
+            x[4 + k] = [m[0] + v[i], m[1] + v[i + 1], m[2] + v[i + 2]];
+        }
+    }
+    x
+}
+
+/// Smallest measure of `b` (min b / mean b; −∞ when the mean is not positive).
+#[inline]
+pub(super) fn min_measure(b: &[f64; 20]) -> f64 {
+    let mean: f64 = b.iter().sum::<f64>() / 20.0;
+    if !(mean > 0.0) {
+        return f64::NEG_INFINITY;
+    }
+    b.iter().fold(f64::INFINITY, |a, &v| a.min(v)) / mean
+}
+
+impl Objective<'_> {
+    /// Smallest measure over the patch at `v`.
+    pub fn min_measure(&self, v: &[f64]) -> f64 {
+        let mut lo = f64::INFINITY;
+        for e in self.elems {
+            let (b, _) = bezier_forward(&nodes(e, v));
+            lo = lo.min(min_measure(&b));
+        }
+        lo
+    }
+
+    /// Objective at `v`, gradient into `g`.
+    pub fn eval(&self, v: &[f64], g: &mut [f64]) -> f64 {
+        g.iter_mut().for_each(|x| *x = 0.0);
+        let eps = self.eps;
+        let lden = (1.0 - eps).ln();
+        let mut total = 0.0;
+        for e in self.elems {
+            let x = nodes(e, v);
+            let (b, tape) = bezier_forward(&x);
+            let mean = b.iter().sum::<f64>() / 20.0;
+            if !(mean > 0.0) {
+                return f64::INFINITY;
+            }
+            let inv = 1.0 / mean;
+            let mut df = [0.0; 20];
+            let mut dm_sum = 0.0;
+            for s in 0..20 {
+                let m = b[s] * inv;
+                if !(m > eps) {
+                    return f64::INFINITY;
+                }
+                let l = (m - eps).ln() - lden;
+                total += (m - 1.0) * (m - 1.0) + l * l;
+                let d = 2.0 * ((m - 1.0) + l / (m - eps));
+                df[s] = d;
+                dm_sum += d * m;
+            }
+            // m_s = b_s / mean: ∂F/∂b_r = f'(m_r)/mean − Σ_s f'(m_s) m_s / (20 mean).
+            let corr = dm_sum / 20.0;
+            let mut gb = [0.0; 20];
+            for s in 0..20 {
+                gb[s] = (df[s] - corr) * inv;
+            }
+            let mut gx = [[0.0; 3]; 10];
+            backprop(&tape, &gb, &mut gx);
+            // Mid nodes follow their corners: x_m = (x_a + x_b)/2 + offset.
+            for (k, [a, b]) in crate::geom::shape::TET10_EDGES.iter().enumerate() {
+                if e.var[4 + k] != FIXED {
+                    let gm = gx[4 + k];
+                    for d in 0..3 {
+                        gx[*a][d] += 0.5 * gm[d];
+                        gx[*b][d] += 0.5 * gm[d];
+                    }
+                }
+            }
+            for n in 0..10 {
+                let i = e.var[n];
+                if i != FIXED {
+                    let i = 3 * i as usize;
+                    for d in 0..3 {
+                        g[i + d] += gx[n][d];
+                    }
+                }
+            }
+        }
+        total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gradient_matches_finite_differences() {
+        let c = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.1, 0.0],
+            [0.2, 0.9, 0.1],
+            [0.3, 0.2, 0.8],
+        ];
+        let mut x = crate::geom::shape::straight_tet10(c);
+        x[4][2] += 0.05;
+        x[9][0] -= 0.04;
+        // Corner 3 and mids 5 and 9 free; mid 9 sits on edge (3, 1).
+        let e = PatchElem {
+            x,
+            var: [FIXED, FIXED, FIXED, 0, FIXED, 1, FIXED, FIXED, FIXED, 2],
+        };
+        let m5 = mid(x[1], x[2]);
+        let m9 = mid(x[3], x[1]);
+        let v0 = vec![
+            x[3][0],
+            x[3][1],
+            x[3][2],
+            x[5][0] - m5[0] + 0.02,
+            x[5][1] - m5[1],
+            x[5][2] - m5[2] - 0.01,
+            x[9][0] - m9[0],
+            x[9][1] - m9[1],
+            x[9][2] - m9[2],
+        ];
+        let elems = [e];
+        let obj = Objective {
+            elems: &elems,
+            eps: 0.2,
+        };
+        let mut g = vec![0.0; 9];
+        let f0 = obj.eval(&v0, &mut g);
+        assert!(f0.is_finite() && f0 > 0.0);
+        let mut scratch = vec![0.0; 9];
+        for i in 0..9 {
+            let h = 1e-7;
+            let mut vp = v0.clone();
+            vp[i] += h;
+            let mut vm = v0.clone();
+            vm[i] -= h;
+            let fd = (obj.eval(&vp, &mut scratch) - obj.eval(&vm, &mut scratch)) / (2.0 * h);
+            assert!((fd - g[i]).abs() < 1e-5 * (1.0 + fd.abs()), "{i}: {fd} vs {}", g[i]);
+        }
+    }
+}
