@@ -13,6 +13,8 @@ use crate::geom::vec3::{cross, dot, sub, P3};
 
 /// Column coefficient `c_d[j]` as (node, integer weight) terms, Gmsh node order (corners
 /// 0..3, mids of (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)); unused terms have weight 0.
+/// The reference for the written-out [`columns`] and [`backprop`] (checked by the tests).
+#[cfg_attr(not(test), allow(dead_code))]
 const COLS: [[[(usize, f64); 4]; 4]; 3] = [
     [
         [(4, 4.0), (1, -1.0), (0, -3.0), (0, 0.0)],
@@ -73,11 +75,9 @@ const WEIGHT: [f64; 20] = {
     w
 };
 
-/// The Jacobian columns and the cross products the coefficients and their derivatives
-/// are made of, for one element.
+/// The Jacobian columns of one element (what [`backprop`] needs).
 pub(crate) struct JacTape {
     c: [[P3; 4]; 3],
-    x12: [[P3; 4]; 4],
 }
 
 /// Coefficients of det J of `x` (in [`BEZIER_INDEX`] order) and the tape for
@@ -86,20 +86,7 @@ pub(crate) struct JacTape {
 pub(crate) fn bezier_forward(x: &[P3; 10]) -> ([f64; 20], JacTape) {
     // Node positions relative to corner 0 (translation invariant, accurate far out).
     let y: [P3; 10] = std::array::from_fn(|i| sub(x[i], x[0]));
-    let mut c = [[[0.0; 3]; 4]; 3];
-    for d in 0..3 {
-        for j in 0..4 {
-            let mut v = [0.0; 3];
-            for &(n, w) in &COLS[d][j] {
-                if w != 0.0 && n != 0 {
-                    for k in 0..3 {
-                        v[k] += w * y[n][k];
-                    }
-                }
-            }
-            c[d][j] = v;
-        }
-    }
+    let c = columns(&y);
     let mut x12 = [[[0.0; 3]; 4]; 4];
     for j in 0..4 {
         for k in 0..4 {
@@ -117,7 +104,7 @@ pub(crate) fn bezier_forward(x: &[P3; 10]) -> ([f64; 20], JacTape) {
     for (v, w) in b.iter_mut().zip(WEIGHT.iter()) {
         *v *= w;
     }
-    (b, JacTape { c, x12 })
+    (b, JacTape { c })
 }
 
 /// Given `gb[s]` = ∂F/∂b_s, add ∂F/∂x_n to `gx[n]` for the ten nodes.
@@ -128,41 +115,101 @@ pub(crate) fn backprop(tape: &JacTape, gb: &[f64; 20], gx: &mut [P3; 10]) {
     for s in 0..20 {
         gs[s] = gb[s] * WEIGHT[s];
     }
-    let mut x20 = [[[0.0; 3]; 4]; 4]; // c2[k] x c0[i]
-    let mut x01 = [[[0.0; 3]; 4]; 4]; // c0[i] x c1[j]
-    for a in 0..4 {
-        for b in 0..4 {
-            x20[a][b] = cross(c[2][a], c[0][b]);
-            x01[a][b] = cross(c[0][a], c[1][b]);
-        }
-    }
+    // W_ijk = gs[slot(i, j, k)] is symmetric in (i, j, k). With U = Σ_k W_ijk c_2[k]:
+    // ∂F/∂c_0[i] = Σ_j c_1[j] × U_ij, and cyclically for c_1 and c_2 (register-friendly
+    // two-step contractions instead of 64 accumulations into memory).
+    let w = |i: usize, j: usize, k: usize| gs[SLOT[16 * i + 4 * j + k] as usize];
     let mut g = [[[0.0; 3]; 4]; 3];
     for i in 0..4 {
+        let (mut a0, mut a1, mut a2) = ([0.0; 3], [0.0; 3], [0.0; 3]);
         for j in 0..4 {
+            let (mut u0, mut u1, mut u2) = ([0.0; 3], [0.0; 3], [0.0; 3]);
             for k in 0..4 {
-                let w = gs[SLOT[16 * i + 4 * j + k] as usize];
-                if w == 0.0 {
-                    continue;
-                }
+                // Slot (i, j, k) for c_0; (j, i, k) ~ (i, j, k) by symmetry, so the same
+                // weights serve the other two contractions with roles rotated.
+                let wt = w(i, j, k);
                 for d in 0..3 {
-                    g[0][i][d] += w * tape.x12[j][k][d];
-                    g[1][j][d] += w * x20[k][i][d];
-                    g[2][k][d] += w * x01[i][j][d];
+                    u0[d] += wt * c[2][k][d];
+                    u1[d] += wt * c[0][k][d];
+                    u2[d] += wt * c[1][k][d];
                 }
             }
-        }
-    }
-    for d in 0..3 {
-        for j in 0..4 {
-            for &(n, w) in &COLS[d][j] {
-                if w != 0.0 {
-                    for k in 0..3 {
-                        gx[n][k] += w * g[d][j][k];
-                    }
-                }
+            let x0 = cross(c[1][j], u0); // contributes to ∂/∂c_0[i]
+            let x1 = cross(c[2][j], u1); // ∂/∂c_1[i]: Σ_{j,k} W c_2[j] × c_0[k]
+            let x2 = cross(c[0][j], u2); // ∂/∂c_2[i]: Σ_{j,k} W c_0[j] × c_1[k]
+            for d in 0..3 {
+                a0[d] += x0[d];
+                a1[d] += x1[d];
+                a2[d] += x2[d];
             }
         }
+        g[0][i] = a0;
+        g[1][i] = a1;
+        g[2][i] = a2;
     }
+    // ∂F/∂x_n = Σ_{d,j} COLS[d][j](n) g[d][j], written out.
+    let lin = |w: [f64; 12]| -> P3 {
+        let mut o = [0.0; 3];
+        for (t, wt) in w.iter().enumerate() {
+            let gv = g[t / 4][t % 4];
+            for k in 0..3 {
+                o[k] += wt * gv[k];
+            }
+        }
+        o
+    };
+    let upd = [
+        lin([-3., 1., 1., 1., -3., 1., 1., 1., -3., 1., 1., 1.]),
+        lin([-1., 3., -1., -1., 0., 0., 0., 0., 0., 0., 0., 0.]),
+        lin([0., 0., 0., 0., -1., -1., 3., -1., 0., 0., 0., 0.]),
+        lin([0., 0., 0., 0., 0., 0., 0., 0., -1., -1., -1., 3.]),
+        lin([4., -4., 0., 0., 0., -4., 0., 0., 0., -4., 0., 0.]),
+        lin([0., 0., 4., 0., 0., 4., 0., 0., 0., 0., 0., 0.]),
+        lin([0., 0., -4., 0., 4., 0., -4., 0., 0., 0., -4., 0.]),
+        lin([0., 0., 0., -4., 0., 0., 0., -4., 4., 0., 0., -4.]),
+        lin([0., 0., 0., 0., 0., 0., 0., 4., 0., 0., 4., 0.]),
+        lin([0., 0., 0., 4., 0., 0., 0., 0., 0., 4., 0., 0.]),
+    ];
+    for (o, u) in gx.iter_mut().zip(upd.iter()) {
+        for k in 0..3 {
+            o[k] += u[k];
+        }
+    }
+}
+
+/// The Jacobian columns `c[d][j]` from node positions relative to corner 0 ([`COLS`]
+/// written out; `y[0]` = 0).
+#[inline]
+fn columns(y: &[P3; 10]) -> [[P3; 4]; 3] {
+    let f = |t: [(usize, f64); 4]| -> P3 {
+        let mut v = [0.0; 3];
+        for (n, w) in t {
+            for k in 0..3 {
+                v[k] += w * y[n][k];
+            }
+        }
+        v
+    };
+    [
+        [
+            f([(4, 4.0), (1, -1.0), (0, 0.0), (0, 0.0)]),
+            f([(1, 3.0), (4, -4.0), (0, 0.0), (0, 0.0)]),
+            f([(5, 4.0), (6, -4.0), (1, -1.0), (0, 0.0)]),
+            f([(9, 4.0), (7, -4.0), (1, -1.0), (0, 0.0)]),
+        ],
+        [
+            f([(6, 4.0), (2, -1.0), (0, 0.0), (0, 0.0)]),
+            f([(5, 4.0), (4, -4.0), (2, -1.0), (0, 0.0)]),
+            f([(2, 3.0), (6, -4.0), (0, 0.0), (0, 0.0)]),
+            f([(8, 4.0), (7, -4.0), (2, -1.0), (0, 0.0)]),
+        ],
+        [
+            f([(7, 4.0), (3, -1.0), (0, 0.0), (0, 0.0)]),
+            f([(9, 4.0), (4, -4.0), (3, -1.0), (0, 0.0)]),
+            f([(8, 4.0), (6, -4.0), (3, -1.0), (0, 0.0)]),
+            f([(3, 3.0), (7, -4.0), (0, 0.0), (0, 0.0)]),
+        ],
+    ]
 }
 
 #[cfg(test)]
@@ -192,6 +239,26 @@ mod tests {
             }
         }
         x
+    }
+
+    #[test]
+    fn written_out_tables_match_cols() {
+        let x = sample();
+        let y: [P3; 10] = std::array::from_fn(|i| sub(x[i], x[0]));
+        let c = columns(&y);
+        for d in 0..3 {
+            for j in 0..4 {
+                let mut v = [0.0; 3];
+                for &(n, w) in &COLS[d][j] {
+                    for k in 0..3 {
+                        v[k] += w * y[n][k];
+                    }
+                }
+                for k in 0..3 {
+                    assert!((v[k] - c[d][j][k]).abs() < 1e-14);
+                }
+            }
+        }
     }
 
     #[test]

@@ -96,8 +96,10 @@ fn element_sj(mesh: &TetMesh, t: usize) -> f64 {
 pub fn optimize_high_order(mesh: &mut TetMesh, bnd: &Boundary, prm: &HighOrderParams) -> HighOrderStats {
     let mut st = HighOrderStats::default();
     let ne = mesh.tets.len();
+    let tt = std::time::Instant::now();
     let mut sj: Vec<f64> = (0..ne).into_par_iter().map(|t| element_sj(mesh, t)).collect();
     let sj_start = sj.clone();
+    eprintln!("initial sj {:.3}s", tt.elapsed().as_secs_f64());
     let census = |sj: &[f64]| {
         let min = sj.iter().copied().fold(f64::INFINITY, f64::min);
         let invalid = sj.iter().filter(|&&v| !(v > 0.0)).count();
@@ -186,6 +188,8 @@ pub fn optimize_high_order(mesh: &mut TetMesh, bnd: &Boundary, prm: &HighOrderPa
     st.min_scaled_jacobian[1] = if ne == 0 { 1.0 } else { m1 };
     st.invalid[1] = i1;
     st.below_threshold[1] = b1;
+ eprintln!("opt {:.3}s cert {:.3}s", OPT_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9, CERT_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9);
+    eprintln!("evals {} element-evals {}", EVALS.load(std::sync::atomic::Ordering::Relaxed), ELEMS.load(std::sync::atomic::Ordering::Relaxed));
     st.elements_improved = sj.iter().zip(&sj_start).filter(|(a, b)| a > b).count();
     st
 }
@@ -249,29 +253,36 @@ fn optimize_patch(
         elems: &elems,
         eps: 0.0,
     };
-    let mut mmin = obj.min_measure(&v);
-    if !mmin.is_finite() || mmin >= 1.0 {
+    let (mut mmin, ratio) = obj.min_measure(&v);
+    if !mmin.is_finite() || mmin >= 1.0 || ratio >= prm.threshold {
         return None;
     }
     let v0 = v.clone();
+    let tt = std::time::Instant::now();
     for _ in 0..prm.barrier_updates {
         obj.eps = if mmin == 0.0 {
             -0.1
         } else {
             mmin - 0.1 * mmin.abs()
         };
-        let mut f = |v: &[f64], g: &mut [f64]| obj.eval(v, g);
+        let mut f = |v: &[f64], g: &mut [f64]| {
+            EVALS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            ELEMS.fetch_add(obj.elems.len(), std::sync::atomic::Ordering::Relaxed);
+            obj.eval(v, g)
+        };
         lb.minimize(&mut v, &mut f, prm.iterations, 0.02 * h);
-        let new = obj.min_measure(&v);
+        let (new, ratio) = obj.min_measure(&v);
         let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
         mmin = new;
-        if stagnated {
+        if stagnated || ratio >= prm.threshold {
             break;
         }
     }
+    OPT_NS.fetch_add(tt.elapsed().as_nanos() as usize, std::sync::atomic::Ordering::Relaxed);
     if v == v0 {
         return None;
     }
+    let tt = std::time::Instant::now();
     // Certify and compare.
     let mut after = Vec::with_capacity(elems.len());
     let mut after_min = f64::INFINITY;
@@ -286,6 +297,7 @@ fn optimize_patch(
         }
         after.push(s);
     }
+    CERT_NS.fetch_add(tt.elapsed().as_nanos() as usize, std::sync::atomic::Ordering::Relaxed);
     if !(after_min > before_min) {
         return None;
     }
@@ -316,4 +328,73 @@ fn optimize_patch(
 fn skew(x: &[P3; 10]) -> f64 {
     let (lo, hi) = dihedral_extremes(&[x[0], x[1], x[2], x[3]]);
     skewness_from_extremes(lo, hi)
+}
+pub(crate) static EVALS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub(crate) static OPT_NS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub(crate) static CERT_NS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+pub(crate) static ELEMS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+#[cfg(test)]
+mod ceiling {
+    use super::*;
+
+    /// Experiment: the best min J / max J each boundary-face element could reach alone
+    /// (its apex and three interior mids free, neighbours ignored).
+    #[test]
+    #[ignore]
+    fn single_element_ceiling() {
+        let path = std::env::var("SURF").unwrap_or("tests/data/sphere_p2.msh".into());
+        let surf = crate::io::read_surface(std::path::Path::new(&path)).unwrap();
+        let opts = crate::Options::default();
+        let size = crate::generate::size_field(&surf, &opts);
+        let f = crate::front::run_front(surf.nodes(), surf.triangles(), &opts, size, &mut |_, _| false).unwrap();
+        let bnd = Boundary::new(surf.nodes().len(), surf.triangles());
+        let (pts, tets, _) = crate::optimize::improve_linear(f.pts, f.tets, &bnd, &Default::default());
+        let mesh = crate::mesh::build::assemble(&pts, &tets, surf.nodes().len(), surf.triangles(), surf.tags());
+        let mut res = Vec::new();
+        for (t, e) in mesh.tets.iter().enumerate() {
+            let nb = e[..4].iter().filter(|&&x| (x as usize) < bnd.n_surf).count();
+            if nb != 3 {
+                continue;
+            }
+            let x = tet_nodes(&mesh, t);
+            let mut var = [FIXED; 10];
+            let mut nv = 0;
+            for k in 0..10 {
+                if (e[k] as usize) >= bnd.n_surf {
+                    var[k] = nv;
+                    nv += 1;
+                }
+            }
+            let elems = [PatchElem { x, var }];
+            let mut v = vec![0.0; 3 * nv as usize];
+            for k in 0..10 {
+                let i = var[k];
+                if i == FIXED { continue; }
+                let val = if k < 4 { x[k] } else {
+                    let [a, b] = crate::geom::shape::TET10_EDGES[k - 4];
+                    let m = mid(x[a], x[b]);
+                    [x[k][0] - m[0], x[k][1] - m[1], x[k][2] - m[2]]
+                };
+                v[3 * i as usize..3 * i as usize + 3].copy_from_slice(&val);
+            }
+            let mut obj = Objective { elems: &elems, eps: 0.0 };
+            let mut lb = Lbfgs::default();
+            let mut mmin = obj.min_measure(&v).0;
+            let h = dist(x[0], x[1]);
+            for _ in 0..30 {
+                obj.eps = mmin - 0.1 * mmin.abs();
+                let mut f = |v: &[f64], g: &mut [f64]| obj.eval(v, g);
+                lb.minimize(&mut v, &mut f, 200, 0.02 * h);
+                mmin = obj.min_measure(&v).0;
+            }
+            let s0 = scaled_jacobian_certified(&x, 1e-3);
+            let s1 = scaled_jacobian_certified(&nodes(&elems[0], &v), 1e-3);
+            res.push((s1, s0, t));
+        }
+        res.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for r in res.iter().take(10) {
+            println!("ceiling {:.4} (from {:.4}) tet {}", r.0, r.1, r.2);
+        }
+    }
 }

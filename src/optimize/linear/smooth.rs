@@ -98,6 +98,9 @@ pub(super) fn smooth_vertex(
     }
     s.star.clear();
     s.star.extend_from_slice(&m.vt[v as usize]);
+    // Worst first, so that a failing trial position is rejected after few evaluations.
+    s.star
+        .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
     let mut p = m.pts[v as usize];
     // Largest step: a third of the shortest edge at v.
     let mut min_len = f64::INFINITY;
@@ -109,6 +112,7 @@ pub(super) fn smooth_vertex(
         }
     }
     let max_move = min_len / 3.0;
+    let mut last_step = max_move;
     let mut qmin = s
         .star
         .iter()
@@ -156,12 +160,13 @@ pub(super) fn smooth_vertex(
         if !(dn > 0.0) || !dn.is_finite() {
             break;
         }
-        let mut alpha = max_move / dn;
+        let mut alpha = (max_move / dn).min(2.0 * last_step / dn);
         let mut accepted = false;
         for _ in 0..prm.max_halvings {
             let np = [p[0] + alpha * d[0], p[1] + alpha * d[1], p[2] + alpha * d[2]];
             let nq = star_min(m, v, &s.star, np, qmin + prm.eps);
             if nq > qmin + prm.eps {
+                last_step = alpha * dn;
                 p = np;
                 qmin = nq;
                 accepted = true;
