@@ -7,31 +7,69 @@ use curvetet::optimize::*;
 use curvetet::{io, Options};
 use std::time::Instant;
 
+fn cpu() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let surf = io::read_surface(std::path::Path::new(&args[1])).unwrap();
     let goal: f64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(0.6);
     let opts = Options::default();
     let t = Instant::now();
+    let c0 = cpu();
     let size = size_field(&surf, &opts);
-    let f = run_front(surf.nodes(), surf.triangles(), &opts, size, &mut |_, _| false).unwrap();
+    let f = run_front(surf.nodes(), surf.triangles(), &opts, size, &mut |_, _| {
+        false
+    })
+    .unwrap();
     let tf = t.elapsed().as_secs_f64();
+    let cf = cpu() - c0;
     let bnd = Boundary::new(surf.nodes().len(), surf.triangles());
-    let prm = LinearParams { goal_skewness: goal, ..Default::default() };
+    let prm = LinearParams {
+        goal_skewness: goal,
+        ..Default::default()
+    };
     let mut tl = f64::INFINITY;
     for _ in 0..2 {
-        let t = Instant::now();
+        let c = cpu();
         let _ = improve_linear(f.pts.clone(), f.tets.clone(), &bnd, &prm);
-        tl = tl.min(t.elapsed().as_secs_f64());
+        tl = tl.min(cpu() - c);
     }
     let (pts, tets, st) = improve_linear(f.pts, f.tets, &bnd, &prm);
-    println!("front {tf:.3}s linear {tl:.3}s {st:?}");
-    let mut mesh = build::assemble(&pts, &tets, surf.nodes().len(), surf.triangles(), surf.tags());
+    println!("front {tf:.3}s cpu {cf:.3}s linear cpu {tl:.3}s {st:?}");
+    let mut mesh = build::assemble(
+        &pts,
+        &tets,
+        surf.nodes().len(),
+        surf.triangles(),
+        surf.tags(),
+    );
     let r = QualityReport::of(&mesh);
-    println!("before HO: tets {} minSJ {:.4} cert {:.4} maxskew {:.4} dih {:.2}..{:.2} invalid {}", r.num_tets, r.quality.scaled_jacobian.min, r.quality.scaled_jacobian_certified.min, r.quality.skewness.max, r.quality.min_dihedral.min, r.quality.max_dihedral.max, r.num_invalid);
+    println!(
+        "before HO: tets {} minSJ {:.4} cert {:.4} maxskew {:.4} dih {:.2}..{:.2} invalid {}",
+        r.num_tets,
+        r.quality.scaled_jacobian.min,
+        r.quality.scaled_jacobian_certified.min,
+        r.quality.skewness.max,
+        r.quality.min_dihedral.min,
+        r.quality.max_dihedral.max,
+        r.num_invalid
+    );
     worst(&mesh, surf.nodes().len(), 8);
     let t = Instant::now();
-    let env = |k: &str, d: f64| std::env::var(k).ok().map(|s| s.parse::<f64>().unwrap()).unwrap_or(d);
+    let c = cpu();
+    let env = |k: &str, d: f64| {
+        std::env::var(k)
+            .ok()
+            .map(|s| s.parse::<f64>().unwrap())
+            .unwrap_or(d)
+    };
     let d = HighOrderParams::default();
     let hp = HighOrderParams {
         threshold: env("TH", d.threshold),
@@ -44,6 +82,7 @@ fn main() {
     };
     let hs = optimize_high_order(&mut mesh, &bnd, &hp);
     let th = t.elapsed().as_secs_f64();
+    println!("HO wall {th:.3}s cpu {:.3}s", cpu() - c);
     worst(&mesh, surf.nodes().len(), 8);
     let r = QualityReport::of(&mesh);
     println!("after HO {th:.3}s: minSJ {:.4} cert {:.4} maxskew {:.4} dih {:.2}..{:.2} invalid {} {hs:?}", r.quality.scaled_jacobian.min, r.quality.scaled_jacobian_certified.min, r.quality.skewness.max, r.quality.min_dihedral.min, r.quality.max_dihedral.max, r.num_invalid);
@@ -53,14 +92,36 @@ fn main() {
 pub fn worst(mesh: &curvetet::TetMesh, n_surf: usize, k: usize) {
     use curvetet::geom::quality::tet_quality;
     use curvetet::mesh::quality::tet_nodes;
-    let mut v: Vec<(f64, usize)> = (0..mesh.tets.len()).map(|t| (tet_quality(&tet_nodes(mesh, t)).scaled_jacobian_certified, t)).collect();
+    let mut v: Vec<(f64, usize)> = (0..mesh.tets.len())
+        .map(|t| {
+            (
+                tet_quality(&tet_nodes(mesh, t)).scaled_jacobian_certified,
+                t,
+            )
+        })
+        .collect();
     v.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let bset: std::collections::HashSet<[u32; 3]> = mesh.boundary.iter().map(|b| { let mut k = [b[0], b[1], b[2]]; k.sort(); k }).collect();
+    let bset: std::collections::HashSet<[u32; 3]> = mesh
+        .boundary
+        .iter()
+        .map(|b| {
+            let mut k = [b[0], b[1], b[2]];
+            k.sort();
+            k
+        })
+        .collect();
     for &(s, t) in v.iter().take(k) {
         let e = mesh.tets[t];
         let nb = e[..4].iter().filter(|&&x| (x as usize) < n_surf).count();
         let nbm = e[4..].iter().filter(|&&x| (x as usize) < n_surf).count();
-        let faces = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]].iter().filter(|f| { let mut k = [e[f[0]], e[f[1]], e[f[2]]]; k.sort(); bset.contains(&k) }).count();
+        let faces = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
+            .iter()
+            .filter(|f| {
+                let mut k = [e[f[0]], e[f[1]], e[f[2]]];
+                k.sort();
+                bset.contains(&k)
+            })
+            .count();
         let q = tet_quality(&tet_nodes(mesh, t));
         println!("  tet {t}: sj {s:.4} bverts {nb} bmids {nbm} bfaces {faces} skew {:.3} dih {:.1}..{:.1}", q.skewness, q.min_dihedral, q.max_dihedral);
     }

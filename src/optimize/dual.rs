@@ -82,6 +82,7 @@ impl Sub for D3 {
     }
 }
 
+#[allow(clippy::suspicious_arithmetic_impl)] // the product rule adds
 impl Mul for D3 {
     type Output = D3;
     #[inline]

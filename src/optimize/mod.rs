@@ -16,6 +16,8 @@ pub mod boundary;
 mod dual;
 pub mod high_order;
 pub mod linear;
+#[cfg(test)]
+mod testmesh;
 
 pub use boundary::Boundary;
 pub use high_order::{optimize_high_order, HighOrderParams, HighOrderStats};

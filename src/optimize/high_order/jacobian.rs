@@ -8,6 +8,9 @@
 //! with multiset `s`. So `∂b_s/∂c_0[i] = w_s Σ c_1[j] × c_2[k]` and cyclically, and the
 //! node gradient follows from [`COLS`].
 
+// Index loops mirror the formulas (several arrays per index).
+#![allow(clippy::needless_range_loop)]
+
 use crate::geom::bezier::BEZIER_INDEX;
 use crate::geom::vec3::{cross, dot, sub, P3};
 
@@ -292,7 +295,11 @@ mod tests {
                 let mut xm = x;
                 xm[n][d] -= h;
                 let fd = (f(&xp) - f(&xm)) / (2.0 * h);
-                assert!((fd - gx[n][d]).abs() < 1e-7 * (1.0 + fd.abs()), "{n} {d}: {fd} vs {}", gx[n][d]);
+                assert!(
+                    (fd - gx[n][d]).abs() < 1e-7 * (1.0 + fd.abs()),
+                    "{n} {d}: {fd} vs {}",
+                    gx[n][d]
+                );
             }
         }
     }

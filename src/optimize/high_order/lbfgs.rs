@@ -4,6 +4,9 @@
 //! its barrier (which general-purpose line searches mishandle), and the buffers are
 //! reused across patches.
 
+// Index loops mirror the formulas (several arrays per index).
+#![allow(clippy::needless_range_loop)]
+
 /// Work buffers, reusable across calls.
 #[derive(Default)]
 pub(crate) struct Lbfgs {
@@ -84,7 +87,7 @@ impl Lbfgs {
                 *v = -*v;
             }
             let mut slope = dot(&self.g, &self.d);
-            if !(slope < 0.0) {
+            if slope.is_nan() || slope >= 0.0 {
                 // Not a descent direction: restart from the scaled gradient.
                 stored = 0;
                 let gn = dot(&self.g, &self.g).sqrt();

@@ -16,8 +16,7 @@ mod lbfgs;
 mod objective;
 mod patch;
 
-use crate::geom::bezier::scaled_jacobian_certified;
-use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, DEFAULT_SJ_REL_TOL};
+use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::{dist, mid, P3};
 use crate::mesh::quality::tet_nodes;
 use crate::mesh::TetMesh;
@@ -50,13 +49,13 @@ pub struct HighOrderParams {
 impl Default for HighOrderParams {
     fn default() -> Self {
         HighOrderParams {
-            threshold: 0.9,
+            threshold: 0.85,
             layers: 1,
             rounds: 3,
             move_vertices: true,
             max_skewness: 0.7,
-            barrier_updates: 8,
-            iterations: 40,
+            barrier_updates: 3,
+            iterations: 10,
         }
     }
 }
@@ -80,29 +79,29 @@ pub struct HighOrderStats {
     pub elements_improved: usize,
 }
 
-/// Certified min J / max J of element `t`.
+/// The optimizer's score of element `t` (see [`objective::score`]).
 #[inline]
-fn element_sj(mesh: &TetMesh, t: usize) -> f64 {
-    let v = scaled_jacobian_certified(&tet_nodes(mesh, t), DEFAULT_SJ_REL_TOL);
-    if v.is_nan() {
-        -1.0
-    } else {
-        v
-    }
+fn element_score(mesh: &TetMesh, t: usize, enough: f64) -> f64 {
+    objective::score(&tet_nodes(mesh, t), enough)
 }
 
 /// Optimize the free nodes of `mesh` (every node at index >= `bnd.n_surf`). Runs on the
 /// current rayon pool; the result is the same for any number of threads.
-pub fn optimize_high_order(mesh: &mut TetMesh, bnd: &Boundary, prm: &HighOrderParams) -> HighOrderStats {
+pub fn optimize_high_order(
+    mesh: &mut TetMesh,
+    bnd: &Boundary,
+    prm: &HighOrderParams,
+) -> HighOrderStats {
     let mut st = HighOrderStats::default();
     let ne = mesh.tets.len();
-    let tt = std::time::Instant::now();
-    let mut sj: Vec<f64> = (0..ne).into_par_iter().map(|t| element_sj(mesh, t)).collect();
+    let mut sj: Vec<f64> = (0..ne)
+        .into_par_iter()
+        .map(|t| element_score(mesh, t, prm.threshold))
+        .collect();
     let sj_start = sj.clone();
-    eprintln!("initial sj {:.3}s", tt.elapsed().as_secs_f64());
     let census = |sj: &[f64]| {
         let min = sj.iter().copied().fold(f64::INFINITY, f64::min);
-        let invalid = sj.iter().filter(|&&v| !(v > 0.0)).count();
+        let invalid = sj.iter().filter(|&&v| v.is_nan() || v <= 0.0).count();
         let below = sj.iter().filter(|&&v| v < prm.threshold).count();
         (min, invalid, below)
     };
@@ -142,9 +141,11 @@ pub fn optimize_high_order(mesh: &mut TetMesh, bnd: &Boundary, prm: &HighOrderPa
             }
             // Seeds all of whose non-surface nodes are free here are covered.
             for &e in &p.elems {
-                let all_free = mesh.tets[e as usize]
-                    .iter()
-                    .all(|&n| (n as usize) < bnd.n_surf || p.free.binary_search(&n).is_ok() || (!prm.move_vertices && adj.is_vertex[n as usize]));
+                let all_free = mesh.tets[e as usize].iter().all(|&n| {
+                    (n as usize) < bnd.n_surf
+                        || p.free.binary_search(&n).is_ok()
+                        || (!prm.move_vertices && adj.is_vertex[n as usize])
+                });
                 if all_free {
                     covered[e as usize] = true;
                 }
@@ -188,8 +189,6 @@ pub fn optimize_high_order(mesh: &mut TetMesh, bnd: &Boundary, prm: &HighOrderPa
     st.min_scaled_jacobian[1] = if ne == 0 { 1.0 } else { m1 };
     st.invalid[1] = i1;
     st.below_threshold[1] = b1;
- eprintln!("opt {:.3}s cert {:.3}s", OPT_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9, CERT_NS.load(std::sync::atomic::Ordering::Relaxed) as f64 * 1e-9);
-    eprintln!("evals {} element-evals {}", EVALS.load(std::sync::atomic::Ordering::Relaxed), ELEMS.load(std::sync::atomic::Ordering::Relaxed));
     st.elements_improved = sj.iter().zip(&sj_start).filter(|(a, b)| a > b).count();
     st
 }
@@ -202,7 +201,51 @@ struct PatchResult {
     sj: Vec<f64>,
 }
 
+/// Run the moving-barrier sequence on `elems` from `v` (updated in place).
+fn run_barrier(elems: &[PatchElem], v: &mut [f64], h: f64, prm: &HighOrderParams, lb: &mut Lbfgs) {
+    let mut obj = Objective { elems, eps: 0.0 };
+    let (mut mmin, ratio) = obj.min_measure(v);
+    if !mmin.is_finite() || mmin >= 1.0 || ratio >= prm.threshold {
+        return;
+    }
+    for _ in 0..prm.barrier_updates {
+        obj.eps = if mmin == 0.0 {
+            -0.1
+        } else {
+            mmin - 0.1 * mmin.abs()
+        };
+        let mut f = |v: &[f64], g: &mut [f64]| obj.eval(v, g);
+        lb.minimize(v, &mut f, prm.iterations, 0.02 * h);
+        let (new, ratio) = obj.min_measure(v);
+        let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
+        mmin = new;
+        if stagnated || ratio >= prm.threshold {
+            break;
+        }
+    }
+}
+
+/// Scores of `elems` at `v`, their minimum and the largest corner skewness.
+fn evaluate(elems: &[PatchElem], v: &[f64], enough: f64, out: &mut Vec<f64>) -> (f64, f64) {
+    out.clear();
+    let mut lo = f64::INFINITY;
+    let mut sk = 0.0f64;
+    for el in elems {
+        let xe = nodes(el, v);
+        let s = objective::score(&xe, enough);
+        lo = lo.min(s);
+        sk = sk.max(skew(&xe));
+        out.push(s);
+    }
+    (lo, sk)
+}
+
 /// Optimize one patch against the node positions `x`; `None` when nothing improved.
+///
+/// Stage A moves the free mid nodes only (the straight-sided shape is kept); when that
+/// leaves the patch below the threshold and vertices may move, stage B continues from
+/// A's result with the free vertices too, kept only if their corner skewness stays
+/// within [`HighOrderParams::max_skewness`] (or below the patch's previous worst).
 fn optimize_patch(
     mesh: &TetMesh,
     x: &[P3],
@@ -216,28 +259,23 @@ fn optimize_patch(
     let mut h = 0.0;
     let mut before_min = f64::INFINITY;
     let mut before_skew = 0.0f64;
-    let mut moves_vertex = false;
     for &e in &p.elems {
         let t = &mesh.tets[e as usize];
         let xe: [P3; 10] = std::array::from_fn(|k| x[t[k] as usize]);
-        let var = t.map(var_of);
-        moves_vertex |= var[..4].iter().any(|&v| v != FIXED);
         h += dist(xe[0], xe[1]);
         before_min = before_min.min(sj[e as usize]);
         before_skew = before_skew.max(skew(&xe));
-        elems.push(PatchElem { x: xe, var });
+        elems.push(PatchElem::new(xe, t.map(var_of)));
     }
     h /= p.elems.len().max(1) as f64;
     // Initial variables: vertex positions, mid offsets from their edge midpoints.
     let mut v = vec![0.0; 3 * p.free.len()];
-    let mut set = vec![false; p.free.len()];
     for el in &elems {
         for k in 0..10 {
             let i = el.var[k];
-            if i == FIXED || set[i as usize] {
+            if i == FIXED {
                 continue;
             }
-            let i = i as usize;
             let val = if k < 4 {
                 el.x[k]
             } else {
@@ -245,81 +283,61 @@ fn optimize_patch(
                 let m = mid(el.x[a], el.x[b]);
                 [el.x[k][0] - m[0], el.x[k][1] - m[1], el.x[k][2] - m[2]]
             };
-            v[3 * i..3 * i + 3].copy_from_slice(&val);
-            set[i] = true;
+            let i = 3 * i as usize;
+            v[i..i + 3].copy_from_slice(&val);
         }
     }
-    let mut obj = Objective {
-        elems: &elems,
-        eps: 0.0,
-    };
-    let (mut mmin, ratio) = obj.min_measure(&v);
-    if !mmin.is_finite() || mmin >= 1.0 || ratio >= prm.threshold {
-        return None;
-    }
+    // Stage A: mid nodes only.
+    let mids: Vec<PatchElem> = elems
+        .iter()
+        .map(|e| {
+            let mut e = e.clone();
+            e.var[..4].iter_mut().for_each(|x| *x = FIXED);
+            e
+        })
+        .filter(PatchElem::has_var)
+        .collect();
     let v0 = v.clone();
-    let tt = std::time::Instant::now();
-    for _ in 0..prm.barrier_updates {
-        obj.eps = if mmin == 0.0 {
-            -0.1
-        } else {
-            mmin - 0.1 * mmin.abs()
-        };
-        let mut f = |v: &[f64], g: &mut [f64]| {
-            EVALS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            ELEMS.fetch_add(obj.elems.len(), std::sync::atomic::Ordering::Relaxed);
-            obj.eval(v, g)
-        };
-        lb.minimize(&mut v, &mut f, prm.iterations, 0.02 * h);
-        let (new, ratio) = obj.min_measure(&v);
-        let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
-        mmin = new;
-        if stagnated || ratio >= prm.threshold {
-            break;
+    if !mids.is_empty() {
+        run_barrier(&mids, &mut v, h, prm, lb);
+    }
+    let mut scores = Vec::with_capacity(elems.len());
+    let (mut best_min, _) = evaluate(&elems, &v, prm.threshold, &mut scores);
+    let mut best: Option<(Vec<f64>, Vec<f64>)> = None;
+    if best_min > before_min && v != v0 {
+        best = Some((v.clone(), scores.clone()));
+    } else {
+        best_min = before_min;
+        v.copy_from_slice(&v0);
+    }
+    // Stage B: vertices too.
+    let has_vertex = elems.iter().any(|e| e.var[..4].iter().any(|&i| i != FIXED));
+    if prm.move_vertices && has_vertex && best_min < prm.threshold {
+        let vb = v.clone();
+        run_barrier(&elems, &mut v, h, prm, lb);
+        if v != vb {
+            let (lo, sk) = evaluate(&elems, &v, prm.threshold, &mut scores);
+            if lo > best_min && sk <= before_skew.max(prm.max_skewness) {
+                best = Some((v.clone(), scores.clone()));
+            }
         }
     }
-    OPT_NS.fetch_add(tt.elapsed().as_nanos() as usize, std::sync::atomic::Ordering::Relaxed);
-    if v == v0 {
-        return None;
-    }
-    let tt = std::time::Instant::now();
-    // Certify and compare.
-    let mut after = Vec::with_capacity(elems.len());
-    let mut after_min = f64::INFINITY;
-    let mut after_skew = 0.0f64;
-    for el in &elems {
-        let xe = nodes(el, &v);
-        let s = scaled_jacobian_certified(&xe, DEFAULT_SJ_REL_TOL);
-        let s = if s.is_nan() { -1.0 } else { s };
-        after_min = after_min.min(s);
-        if moves_vertex {
-            after_skew = after_skew.max(skew(&xe));
-        }
-        after.push(s);
-    }
-    CERT_NS.fetch_add(tt.elapsed().as_nanos() as usize, std::sync::atomic::Ordering::Relaxed);
-    if !(after_min > before_min) {
-        return None;
-    }
-    if moves_vertex && after_skew > before_skew.max(prm.max_skewness) {
-        return None;
-    }
+    let (v, sj_new) = best?;
     // Final free node positions.
     let mut pos = vec![[0.0; 3]; p.free.len()];
     let mut done = vec![false; p.free.len()];
     for el in &elems {
         let xe = nodes(el, &v);
-        for k in 0..10 {
-            let i = el.var[k];
+        for (&i, &xk) in el.var.iter().zip(xe.iter()) {
             if i != FIXED && !done[i as usize] {
-                pos[i as usize] = xe[k];
+                pos[i as usize] = xk;
                 done[i as usize] = true;
             }
         }
     }
     Some(PatchResult {
         positions: pos,
-        sj: after,
+        sj: sj_new,
     })
 }
 
@@ -329,14 +347,11 @@ fn skew(x: &[P3; 10]) -> f64 {
     let (lo, hi) = dihedral_extremes(&[x[0], x[1], x[2], x[3]]);
     skewness_from_extremes(lo, hi)
 }
-pub(crate) static EVALS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub(crate) static OPT_NS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub(crate) static CERT_NS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-pub(crate) static ELEMS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 #[cfg(test)]
 mod ceiling {
     use super::*;
+    use crate::geom::bezier::scaled_jacobian_certified;
 
     /// Experiment: the best min J / max J each boundary-face element could reach alone
     /// (its apex and three interior mids free, neighbours ignored).
@@ -347,13 +362,27 @@ mod ceiling {
         let surf = crate::io::read_surface(std::path::Path::new(&path)).unwrap();
         let opts = crate::Options::default();
         let size = crate::generate::size_field(&surf, &opts);
-        let f = crate::front::run_front(surf.nodes(), surf.triangles(), &opts, size, &mut |_, _| false).unwrap();
+        let f =
+            crate::front::run_front(surf.nodes(), surf.triangles(), &opts, size, &mut |_, _| {
+                false
+            })
+            .unwrap();
         let bnd = Boundary::new(surf.nodes().len(), surf.triangles());
-        let (pts, tets, _) = crate::optimize::improve_linear(f.pts, f.tets, &bnd, &Default::default());
-        let mesh = crate::mesh::build::assemble(&pts, &tets, surf.nodes().len(), surf.triangles(), surf.tags());
+        let (pts, tets, _) =
+            crate::optimize::improve_linear(f.pts, f.tets, &bnd, &Default::default());
+        let mesh = crate::mesh::build::assemble(
+            &pts,
+            &tets,
+            surf.nodes().len(),
+            surf.triangles(),
+            surf.tags(),
+        );
         let mut res = Vec::new();
         for (t, e) in mesh.tets.iter().enumerate() {
-            let nb = e[..4].iter().filter(|&&x| (x as usize) < bnd.n_surf).count();
+            let nb = e[..4]
+                .iter()
+                .filter(|&&x| (x as usize) < bnd.n_surf)
+                .count();
             if nb != 3 {
                 continue;
             }
@@ -366,19 +395,26 @@ mod ceiling {
                     nv += 1;
                 }
             }
-            let elems = [PatchElem { x, var }];
+            let elems = [PatchElem::new(x, var)];
             let mut v = vec![0.0; 3 * nv as usize];
             for k in 0..10 {
                 let i = var[k];
-                if i == FIXED { continue; }
-                let val = if k < 4 { x[k] } else {
+                if i == FIXED {
+                    continue;
+                }
+                let val = if k < 4 {
+                    x[k]
+                } else {
                     let [a, b] = crate::geom::shape::TET10_EDGES[k - 4];
                     let m = mid(x[a], x[b]);
                     [x[k][0] - m[0], x[k][1] - m[1], x[k][2] - m[2]]
                 };
                 v[3 * i as usize..3 * i as usize + 3].copy_from_slice(&val);
             }
-            let mut obj = Objective { elems: &elems, eps: 0.0 };
+            let mut obj = Objective {
+                elems: &elems,
+                eps: 0.0,
+            };
             let mut lb = Lbfgs::default();
             let mut mmin = obj.min_measure(&v).0;
             let h = dist(x[0], x[1]);
@@ -396,5 +432,131 @@ mod ceiling {
         for r in res.iter().take(10) {
             println!("ceiling {:.4} (from {:.4}) tet {}", r.0, r.1, r.2);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::quality::uncertified;
+    use crate::optimize::testmesh::cube;
+    use rand::{Rng, SeedableRng};
+
+    /// A free (interior, non-corner) mid node of `m` near the cube's centre.
+    fn central_mid(m: &TetMesh, n_surf: usize) -> u32 {
+        let adj = NodeElems::new(m);
+        let mut best = (f64::INFINITY, 0u32);
+        for n in n_surf..m.nodes.len() {
+            if adj.is_vertex[n] {
+                continue;
+            }
+            let d = dist(m.nodes[n], [0.5, 0.5, 0.5]);
+            if d < best.0 {
+                best = (d, n as u32);
+            }
+        }
+        best.1
+    }
+
+    #[test]
+    fn untangles_an_invalid_patch_and_keeps_the_boundary() {
+        let c = cube(3, 0.05);
+        let bnd = c.boundary();
+        let mut m = c.p2();
+        let n = central_mid(&m, c.n_surf) as usize;
+        m.nodes[n][0] += 0.25;
+        m.nodes[n][1] -= 0.15;
+        let bad = uncertified(&m);
+        assert!(!bad.is_empty(), "the test needs invalid elements");
+        let surf_before = m.nodes[..c.n_surf].to_vec();
+        let st = optimize_high_order(&mut m, &bnd, &HighOrderParams::default());
+        assert!(uncertified(&m).is_empty(), "{st:?}");
+        assert_eq!(st.invalid[1], 0);
+        assert!(st.invalid[0] > 0);
+        assert!(st.min_scaled_jacobian[1] > 0.5, "{st:?}");
+        // Surface nodes bit-identical.
+        for (a, b) in surf_before.iter().zip(&m.nodes[..c.n_surf]) {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        }
+    }
+
+    #[test]
+    fn same_result_for_one_two_and_four_threads() {
+        let c = cube(4, 0.08);
+        let bnd = c.boundary();
+        let mut base = c.p2();
+        let adj = NodeElems::new(&base);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        for n in c.n_surf..base.nodes.len() {
+            if !adj.is_vertex[n] {
+                for d in 0..3 {
+                    base.nodes[n][d] += rng.random_range(-0.04..0.04);
+                }
+            }
+        }
+        let mut out: Vec<(Vec<P3>, String)> = Vec::new();
+        for threads in [1, 2, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut m = base.clone();
+            let st =
+                pool.install(|| optimize_high_order(&mut m, &bnd, &HighOrderParams::default()));
+            assert!(st.patches > 1, "{st:?}");
+            out.push((m.nodes, format!("{st:?}")));
+        }
+        for o in &out[1..] {
+            assert_eq!(o.1, out[0].1);
+            assert!(o
+                .0
+                .iter()
+                .zip(&out[0].0)
+                .all(|(a, b)| a.map(f64::to_bits) == b.map(f64::to_bits)));
+        }
+    }
+}
+#[cfg(test)]
+mod stress {
+    use super::*;
+    use crate::optimize::testmesh::cube;
+    use rand::{Rng, SeedableRng};
+    #[test]
+    #[ignore]
+    fn random_tangle() {
+        let amp: f64 = std::env::var("AMP")
+            .map(|s| s.parse().unwrap())
+            .unwrap_or(0.04);
+        let c = cube(4, 0.08);
+        let bnd = c.boundary();
+        let mut m = c.p2();
+        let adj = NodeElems::new(&m);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        for n in c.n_surf..m.nodes.len() {
+            if !adj.is_vertex[n] {
+                for d in 0..3 {
+                    m.nodes[n][d] += rng.random_range(-amp..amp);
+                }
+            }
+        }
+        let env = |k: &str, d: f64| {
+            std::env::var(k)
+                .ok()
+                .map(|s| s.parse::<f64>().unwrap())
+                .unwrap_or(d)
+        };
+        let d = HighOrderParams::default();
+        let hp = HighOrderParams {
+            threshold: env("TH", d.threshold),
+            layers: env("LAYERS", d.layers as f64) as usize,
+            rounds: env("ROUNDS", d.rounds as f64) as usize,
+            move_vertices: env("MV", 1.0) > 0.0,
+            max_skewness: env("MAXSKEW", d.max_skewness),
+            barrier_updates: env("BAR", d.barrier_updates as f64) as usize,
+            iterations: env("IT", d.iterations as f64) as usize,
+        };
+        let t = std::time::Instant::now();
+        let st = optimize_high_order(&mut m, &bnd, &hp);
+        eprintln!("{:.2}s {st:?}", t.elapsed().as_secs_f64());
     }
 }

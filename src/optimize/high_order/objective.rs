@@ -1,14 +1,23 @@
 //! The objective of one patch: for every element with a free node and every Bernstein
-//! coefficient `b_s` of its det J, the measure `m_s = b_s / mean(b)` (1 for every
+//! coefficient `b_s` of its det J, the measure `m_s = b_s / N(mean(b))` (1 for every
 //! coefficient of a straight-sided tet; the certified min J / max J is at least
 //! min m / max m) enters Gmsh's log-barrier function
 //! `f(m) = (m − 1)² + ln²((m − ε) / (1 − ε))`, +∞ for m ≤ ε, with ε below the current
 //! minimum (moved up between runs by the caller).
 //!
+//! `N(μ) = (μ + sqrt(μ² + δ²)) / 2` is the mean μ itself for a sound element (δ is 5% of
+//! the element's initial straight-sided det J) and stays positive for a badly tangled
+//! one whose mean is ≤ 0, so the barrier can start from any state.
+//!
 //! Variables: each free vertex's position, and for each free mid node its offset from
 //! its edge's midpoint (so a mid node follows its moving corners).
 
+// Index loops mirror the formulas (several arrays per index).
+#![allow(clippy::needless_range_loop)]
+
 use super::jacobian::{backprop, bezier_forward};
+use crate::geom::bezier::scaled_jacobian_certified;
+use crate::geom::quality::DEFAULT_SJ_REL_TOL;
 use crate::geom::vec3::{mid, P3};
 
 /// No variable.
@@ -22,6 +31,76 @@ pub(super) struct PatchElem {
     /// Variable of each node ([`FIXED`] when fixed); corners 0..4 are positions, mids
     /// 4..10 offsets from their edge midpoint.
     pub var: [u32; 10],
+    /// δ of the normalization (see the module docs).
+    pub delta: f64,
+}
+
+impl PatchElem {
+    /// An element with nodes `x` and variables `var`.
+    pub fn new(x: [P3; 10], var: [u32; 10]) -> PatchElem {
+        PatchElem {
+            x,
+            var,
+            delta: delta_of(&x),
+        }
+    }
+
+    /// True when some node is a variable.
+    pub fn has_var(&self) -> bool {
+        self.var.iter().any(|&v| v != FIXED)
+    }
+}
+
+/// δ of the normalization for nodes `x`.
+fn delta_of(x: &[P3; 10]) -> f64 {
+    let js = crate::geom::vec3::tet_det(x[0], x[1], x[2], x[3]).abs();
+    if js > 0.0 {
+        0.05 * js
+    } else {
+        let (b, _) = bezier_forward(x);
+        0.05 * b.iter().fold(0.0f64, |a, v| a.max(v.abs()))
+    }
+}
+
+/// The score the optimizer ranks elements by: the certified min J / max J of a
+/// certified-valid element (in (0, 1]), else its smallest measure min b / N(mean b)
+/// clamped to ≤ 0 (so every valid element ranks above every invalid one, and invalid
+/// ones rank by how far the barrier has to push them).
+///
+/// When the unrefined Bernstein ratio min b / max b already reaches `enough`, that
+/// ratio (a lower bound of min J / max J, up to rounding) is returned without the
+/// subdivision that certifies the exact value: the optimizer only needs to know such an
+/// element is good enough.
+pub(super) fn score(x: &[P3; 10], enough: f64) -> f64 {
+    let (b, _) = bezier_forward(x);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &v in &b {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > 0.0 && lo >= enough * hi {
+        return lo / hi;
+    }
+    let s = scaled_jacobian_certified(x, DEFAULT_SJ_REL_TOL);
+    if s > 0.0 {
+        return s;
+    }
+    let m = min_measure(&b, delta_of(x));
+    if m.is_nan() {
+        f64::NEG_INFINITY
+    } else {
+        m.min(0.0)
+    }
+}
+
+/// The normalization N(μ) and its derivative.
+#[inline]
+fn norm_of_mean(mu: f64, delta: f64) -> (f64, f64) {
+    let r = (mu * mu + delta * delta).sqrt();
+    (
+        0.5 * (mu + r),
+        0.5 * (1.0 + if r > 0.0 { mu / r } else { 0.0 }),
+    )
 }
 
 /// The elements of a patch and the barrier.
@@ -54,14 +133,15 @@ pub(super) fn nodes(e: &PatchElem, v: &[f64]) -> [P3; 10] {
     x
 }
 
-/// Smallest measure of `b` (min b / mean b; −∞ when the mean is not positive).
+/// Smallest measure of `b` (min b / N(mean b)).
 #[inline]
-pub(super) fn min_measure(b: &[f64; 20]) -> f64 {
+pub(super) fn min_measure(b: &[f64; 20], delta: f64) -> f64 {
     let mean: f64 = b.iter().sum::<f64>() / 20.0;
-    if !(mean > 0.0) {
+    let (n, _) = norm_of_mean(mean, delta);
+    if n.is_nan() || n <= 0.0 {
         return f64::NEG_INFINITY;
     }
-    b.iter().fold(f64::INFINITY, |a, &v| a.min(v)) / mean
+    b.iter().fold(f64::INFINITY, |a, &v| a.min(v)) / n
 }
 
 impl Objective<'_> {
@@ -72,7 +152,7 @@ impl Objective<'_> {
         let mut ratio = f64::INFINITY;
         for e in self.elems {
             let (b, _) = bezier_forward(&nodes(e, v));
-            lo = lo.min(min_measure(&b));
+            lo = lo.min(min_measure(&b, e.delta));
             let (mut bmin, mut bmax) = (f64::INFINITY, f64::NEG_INFINITY);
             for &x in &b {
                 bmin = bmin.min(x);
@@ -93,15 +173,16 @@ impl Objective<'_> {
             let x = nodes(e, v);
             let (b, tape) = bezier_forward(&x);
             let mean = b.iter().sum::<f64>() / 20.0;
-            if !(mean > 0.0) {
+            let (nrm, dn) = norm_of_mean(mean, e.delta);
+            if nrm.is_nan() || nrm <= 0.0 {
                 return f64::INFINITY;
             }
-            let inv = 1.0 / mean;
+            let inv = 1.0 / nrm;
             let mut df = [0.0; 20];
             let mut dm_sum = 0.0;
             for s in 0..20 {
                 let m = b[s] * inv;
-                if !(m > eps) {
+                if m.is_nan() || m <= eps {
                     return f64::INFINITY;
                 }
                 let l = (m - eps).ln() - lden;
@@ -110,8 +191,8 @@ impl Objective<'_> {
                 df[s] = d;
                 dm_sum += d * m;
             }
-            // m_s = b_s / mean: ∂F/∂b_r = f'(m_r)/mean − Σ_s f'(m_s) m_s / (20 mean).
-            let corr = dm_sum / 20.0;
+            // m_s = b_s / N(mean): ∂F/∂b_r = f'(m_r)/N − N' Σ_s f'(m_s) m_s / (20 N).
+            let corr = dm_sum * dn / 20.0;
             let mut gb = [0.0; 20];
             for s in 0..20 {
                 gb[s] = (df[s] - corr) * inv;
@@ -158,10 +239,10 @@ mod tests {
         x[4][2] += 0.05;
         x[9][0] -= 0.04;
         // Corner 3 and mids 5 and 9 free; mid 9 sits on edge (3, 1).
-        let e = PatchElem {
+        let e = PatchElem::new(
             x,
-            var: [FIXED, FIXED, FIXED, 0, FIXED, 1, FIXED, FIXED, FIXED, 2],
-        };
+            [FIXED, FIXED, FIXED, 0, FIXED, 1, FIXED, FIXED, FIXED, 2],
+        );
         let m5 = mid(x[1], x[2]);
         let m9 = mid(x[3], x[1]);
         let v0 = vec![
@@ -191,7 +272,11 @@ mod tests {
             let mut vm = v0.clone();
             vm[i] -= h;
             let fd = (obj.eval(&vp, &mut scratch) - obj.eval(&vm, &mut scratch)) / (2.0 * h);
-            assert!((fd - g[i]).abs() < 1e-5 * (1.0 + fd.abs()), "{i}: {fd} vs {}", g[i]);
+            assert!(
+                (fd - g[i]).abs() < 1e-5 * (1.0 + fd.abs()),
+                "{i}: {fd} vs {}",
+                g[i]
+            );
         }
     }
 }
@@ -214,9 +299,12 @@ mod bench {
         let mut elems = Vec::new();
         for _ in 0..100 {
             let var = [FIXED, FIXED, FIXED, 0, 1, 2, 3, 4, 5, 6];
-            elems.push(PatchElem { x, var });
+            elems.push(PatchElem::new(x, var));
         }
-        let obj = Objective { elems: &elems, eps: -0.5 };
+        let obj = Objective {
+            elems: &elems,
+            eps: -0.5,
+        };
         let mut v = vec![0.01; 21];
         v[..3].copy_from_slice(&x[3]);
         let mut g = vec![0.0; 21];

@@ -22,6 +22,8 @@ pub(super) struct LinMesh<'a> {
     pub bnd: &'a Boundary,
     /// The element quality measure.
     pub eq: ElementQuality,
+    /// Per point: its star changed since it was last smoothed to a standstill.
+    pub dirty: Vec<bool>,
     /// Deleted slots, reused by [`LinMesh::add`] (last freed first).
     free: Vec<u32>,
 }
@@ -42,8 +44,10 @@ impl<'a> LinMesh<'a> {
             vt,
             bnd,
             eq,
+            dirty: vec![true; 0],
             free: Vec::new(),
         };
+        m.dirty = vec![true; m.pts.len()];
         for i in 0..m.tets.len() {
             m.q[i] = m.quality(m.tets[i]);
         }
@@ -87,6 +91,7 @@ impl<'a> LinMesh<'a> {
         };
         for &x in &v {
             self.vt[x as usize].push(t);
+            self.dirty[x as usize] = true;
         }
         t
     }
@@ -95,6 +100,7 @@ impl<'a> LinMesh<'a> {
     pub fn remove(&mut self, t: u32) {
         let v = self.tets[t as usize];
         for &x in &v {
+            self.dirty[x as usize] = true;
             let s = &mut self.vt[x as usize];
             if let Some(i) = s.iter().position(|&y| y == t) {
                 s.swap_remove(i);
@@ -103,6 +109,16 @@ impl<'a> LinMesh<'a> {
         self.tets[t as usize] = DEAD;
         self.q[t as usize] = f64::INFINITY;
         self.free.push(t);
+    }
+
+    /// Mark every corner of the star of `v` dirty (after `v` moved).
+    pub fn touch_star(&mut self, v: u32) {
+        for i in 0..self.vt[v as usize].len() {
+            let t = self.vt[v as usize][i];
+            for x in self.tets[t as usize] {
+                self.dirty[x as usize] = true;
+            }
+        }
     }
 
     /// The live tets containing both `a` and `b`, appended to `out` (cleared first).

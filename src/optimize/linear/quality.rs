@@ -34,7 +34,11 @@ impl ElementQuality {
             let (x, curved) = bnd.tet10(pts, v, c);
             if curved && !certify(&x).is_valid() {
                 let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
-                let sj = if sj.is_nan() { -1.0 } else { sj.clamp(-1.0, 0.0) };
+                let sj = if sj.is_nan() {
+                    -1.0
+                } else {
+                    sj.clamp(-1.0, 0.0)
+                };
                 return -1.0 + 0.5 * (1.0 + sj);
             }
         }

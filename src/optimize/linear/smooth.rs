@@ -38,7 +38,7 @@ impl Default for SmoothParams {
 pub(super) struct SmoothScratch {
     star: Vec<u32>,
     grads: Vec<[f64; 3]>,
-    vals: Vec<(f64, [f64; 3])>,
+    qs: Vec<f64>,
 }
 
 /// Minimum-norm point of the convex hull of `g` (Gilbert's algorithm; few points).
@@ -70,14 +70,16 @@ fn min_norm_point(g: &[[f64; 3]]) -> [f64; 3] {
     x
 }
 
-/// Minimum quality of the star of `v` with `v` at `p`; stops early (returning a value
-/// <= `floor`) as soon as some tet is not above `floor`.
-fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64) -> f64 {
+/// Minimum quality of the star of `v` with `v` at `p` (each tet's into `qs`); stops early
+/// (returning a value <= `floor`) as soon as some tet is not above `floor`.
+fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64, qs: &mut Vec<f64>) -> f64 {
     let mut lo = f64::INFINITY;
+    qs.clear();
     for &t in star {
         let tv = m.tets[t as usize];
         let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
         let q = m.quality_at(tv, &c);
+        qs.push(q);
         lo = lo.min(q);
         if lo <= floor {
             break;
@@ -93,7 +95,7 @@ pub(super) fn smooth_vertex(
     prm: &SmoothParams,
     s: &mut SmoothScratch,
 ) -> bool {
-    if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() {
+    if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() || !m.dirty[v as usize] {
         return false;
     }
     s.star.clear();
@@ -122,7 +124,6 @@ pub(super) fn smooth_vertex(
     for _ in 0..prm.max_iter {
         // Active pieces and their gradients.
         s.grads.clear();
-        s.vals.clear();
         for &t in &s.star {
             let tv = m.tets[t as usize];
             let k = tv.iter().position(|&x| x == v).unwrap_or(0);
@@ -157,14 +158,18 @@ pub(super) fn smooth_vertex(
         }
         let d = min_norm_point(&s.grads);
         let dn = norm(d);
-        if !(dn > 0.0) || !dn.is_finite() {
+        if !dn.is_finite() || dn <= 0.0 {
             break;
         }
         let mut alpha = (max_move / dn).min(2.0 * last_step / dn);
         let mut accepted = false;
         for _ in 0..prm.max_halvings {
-            let np = [p[0] + alpha * d[0], p[1] + alpha * d[1], p[2] + alpha * d[2]];
-            let nq = star_min(m, v, &s.star, np, qmin + prm.eps);
+            let np = [
+                p[0] + alpha * d[0],
+                p[1] + alpha * d[1],
+                p[2] + alpha * d[2],
+            ];
+            let nq = star_min(m, v, &s.star, np, qmin + prm.eps, &mut s.qs);
             if nq > qmin + prm.eps {
                 last_step = alpha * dn;
                 p = np;
@@ -179,11 +184,12 @@ pub(super) fn smooth_vertex(
         }
         moved = true;
         m.pts[v as usize] = p;
-        for i in 0..s.star.len() {
-            let t = s.star[i];
-            m.q[t as usize] = m.quality(m.tets[t as usize]);
+        m.touch_star(v);
+        for (&t, &q) in s.star.iter().zip(&s.qs) {
+            m.q[t as usize] = q;
         }
     }
+    m.dirty[v as usize] = false;
     moved
 }
 
