@@ -80,10 +80,10 @@ pub(crate) fn cube(k: usize, bulge: f64) -> CubeMesh {
     let mut count: HashMap<[u32; 3], u32> = HashMap::new();
     for t in &tets {
         for f in [
-            [t[1], t[3], t[2]],
-            [t[0], t[2], t[3]],
-            [t[0], t[3], t[1]],
-            [t[0], t[1], t[2]],
+            [t[1], t[2], t[3]],
+            [t[0], t[3], t[2]],
+            [t[0], t[1], t[3]],
+            [t[0], t[2], t[1]],
         ] {
             let mut key = f;
             key.sort_unstable();
@@ -146,5 +146,19 @@ pub(crate) fn cube(k: usize, bulge: f64) -> CubeMesh {
         tets,
         n_surf,
         tris,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cube_is_conforming() {
+        for bulge in [0.0, 0.05] {
+            let c = super::cube(3, bulge);
+            let m = c.p2();
+            let conf = crate::mesh::check::check_conformity(&m).unwrap();
+            assert!((conf.volume_linear - 1.0).abs() < 1e-12);
+            assert!(crate::mesh::quality::uncertified(&m).is_empty());
+        }
     }
 }

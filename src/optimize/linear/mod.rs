@@ -175,3 +175,241 @@ fn improve_tet(m: &mut LinMesh, t: u32, eps: f64, sc: &mut Scratch, st: &mut Lin
     }
     moved
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::predicates::orient3d;
+    use crate::optimize::testmesh::cube;
+    use rand::{Rng, SeedableRng};
+    use std::collections::HashMap;
+
+    /// Three tets around the edge (a, b) = (3, 4) of a bipyramid on an equilateral
+    /// triangle of side 1, apexes at heights ±h; every vertex fixed.
+    fn bipyramid(h: f64) -> (Vec<P3>, Vec<[u32; 4]>) {
+        let s3 = 3f64.sqrt();
+        let pts = vec![
+            [1.0 / s3, 0.0, 0.0],
+            [-0.5 / s3, 0.5, 0.0],
+            [-0.5 / s3, -0.5, 0.0],
+            [0.0, 0.0, h],
+            [0.0, 0.0, -h],
+        ];
+        let mut tets = Vec::new();
+        for i in 0..3u32 {
+            let mut t = [3, 4, i, (i + 1) % 3];
+            let x = t.map(|v| pts[v as usize]);
+            if orient3d(x[0], x[1], x[2], x[3]) < 0 {
+                t.swap(2, 3);
+            }
+            tets.push(t);
+        }
+        (pts, tets)
+    }
+
+    fn min_q(m: &LinMesh) -> f64 {
+        (0..m.tets.len() as u32)
+            .filter(|&t| m.alive(t))
+            .map(|t| m.q[t as usize])
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    fn all_positive(pts: &[P3], tets: &[[u32; 4]]) -> bool {
+        tets.iter().all(|t| {
+            let x = t.map(|v| pts[v as usize]);
+            orient3d(x[0], x[1], x[2], x[3]) > 0
+        })
+    }
+
+    #[test]
+    fn edge_removal_turns_a_tall_bipyramid_into_two_good_tets() {
+        let (pts, tets) = bipyramid(0.8);
+        let bnd = Boundary::new(5, &[]);
+        let mut m = LinMesh::new(pts, tets, &bnd, ElementQuality);
+        let before = min_q(&m);
+        assert!(before < 0.4, "skewness {}", 1.0 - before);
+        assert!(remove_edge(&mut m, 3, 4, 1e-9, &mut FlipScratch::default()));
+        let (pts, tets) = m.into_parts();
+        assert_eq!(tets.len(), 2);
+        assert!(all_positive(&pts, &tets));
+        let m = LinMesh::new(pts, tets, &bnd, ElementQuality);
+        assert!(min_q(&m) > 0.99, "skewness {}", 1.0 - min_q(&m));
+    }
+
+    #[test]
+    fn flip23_turns_a_flat_bipyramid_into_three_tets() {
+        let (pts, three) = bipyramid(0.1);
+        let bnd = Boundary::new(5, &[]);
+        let m3 = LinMesh::new(pts.clone(), three, &bnd, ElementQuality);
+        let q3 = min_q(&m3);
+        // The same bipyramid as two flat tets sharing the triangle.
+        let mut two = vec![[0, 1, 2, 3], [0, 2, 1, 4]];
+        for t in two.iter_mut() {
+            let x = t.map(|v| pts[v as usize]);
+            if orient3d(x[0], x[1], x[2], x[3]) < 0 {
+                t.swap(0, 1);
+            }
+        }
+        let mut m = LinMesh::new(pts, two, &bnd, ElementQuality);
+        let q2 = min_q(&m);
+        assert!(q3 > q2);
+        let k = m.tets[0].iter().position(|&v| v >= 3).unwrap();
+        assert!(flip23(&mut m, 0, k, 1e-9));
+        assert!((min_q(&m) - q3).abs() < 1e-12);
+        let (pts, tets) = m.into_parts();
+        assert_eq!(tets.len(), 3);
+        assert!(all_positive(&pts, &tets));
+        // A flip that would not improve is refused.
+        let (pts, three) = bipyramid(0.8);
+        let mut two = vec![[0, 1, 2, 3], [0, 2, 1, 4]];
+        for t in two.iter_mut() {
+            let x = t.map(|v| pts[v as usize]);
+            if orient3d(x[0], x[1], x[2], x[3]) < 0 {
+                t.swap(0, 1);
+            }
+        }
+        drop(three);
+        let mut m = LinMesh::new(pts, two, &bnd, ElementQuality);
+        let k = m.tets[0].iter().position(|&v| v >= 3).unwrap();
+        assert!(!flip23(&mut m, 0, k, 1e-9));
+    }
+
+    #[test]
+    fn smoother_centres_a_vertex_and_never_moves_the_boundary() {
+        // An icosahedron's vertices (fixed) around one interior vertex pulled off centre.
+        let g = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut pts: Vec<P3> = Vec::new();
+        for (a, b) in [(1.0, g), (-1.0, g), (1.0, -g), (-1.0, -g)] {
+            pts.push([0.0, a, b]);
+            pts.push([a, b, 0.0]);
+            pts.push([b, 0.0, a]);
+        }
+        pts.push([0.55, 0.3, -0.2]);
+        let c = 12u32;
+        // Faces: triples of mutually adjacent vertices (edge length 2).
+        let mut tets = Vec::new();
+        for i in 0..12 {
+            for j in i + 1..12 {
+                for k in j + 1..12 {
+                    let e = |a: usize, b: usize| {
+                        (crate::geom::vec3::dist(pts[a], pts[b]) - 2.0).abs() < 1e-9
+                    };
+                    if e(i, j) && e(j, k) && e(i, k) {
+                        let mut t = [i as u32, j as u32, k as u32, c];
+                        let x = t.map(|v| pts[v as usize]);
+                        if orient3d(x[0], x[1], x[2], x[3]) < 0 {
+                            t.swap(0, 1);
+                        }
+                        tets.push(t);
+                    }
+                }
+            }
+        }
+        assert_eq!(tets.len(), 20);
+        let fixed: Vec<P3> = pts[..12].to_vec();
+        let bnd = Boundary::new(12, &[]);
+        let mut m = LinMesh::new(pts, tets, &bnd, ElementQuality);
+        let before = min_q(&m);
+        for v in 0..12 {
+            assert!(!smooth_vertex(
+                &mut m,
+                v,
+                &SmoothParams::default(),
+                &mut SmoothScratch::default()
+            ));
+        }
+        assert!(smooth_vertex(
+            &mut m,
+            c,
+            &SmoothParams::default(),
+            &mut SmoothScratch::default()
+        ));
+        let after = min_q(&m);
+        assert!(after > before + 0.1, "{before} -> {after}");
+        assert!(
+            crate::geom::vec3::norm(m.pts[c as usize]) < 0.05,
+            "{:?}",
+            m.pts[c as usize]
+        );
+        for (a, b) in fixed.iter().zip(&m.pts[..12]) {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        }
+        // Cached qualities are the true ones.
+        for t in 0..m.tets.len() {
+            assert_eq!(m.q[t], m.quality(m.tets[t]));
+        }
+    }
+
+    /// Faces of exactly one tet, as sorted triples.
+    fn boundary_faces(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
+        let mut count: HashMap<[u32; 3], u32> = HashMap::new();
+        for t in tets {
+            for k in 0..4 {
+                let mut f = [0u32; 3];
+                let mut n = 0;
+                for (i, &v) in t.iter().enumerate() {
+                    if i != k {
+                        f[n] = v;
+                        n += 1;
+                    }
+                }
+                f.sort_unstable();
+                *count.entry(f).or_insert(0) += 1;
+            }
+        }
+        let mut out: Vec<[u32; 3]> = count
+            .into_iter()
+            .filter(|(_, c)| *c == 1)
+            .map(|(f, _)| f)
+            .collect();
+        out.sort_unstable();
+        out
+    }
+
+    #[test]
+    fn improve_linear_keeps_the_boundary_and_validity_and_raises_the_worst() {
+        let c = cube(4, 0.06);
+        let bnd = c.boundary();
+        // Shake the interior vertices (keeping every tet positive).
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let mut pts = c.pts.clone();
+        for v in c.n_surf..pts.len() {
+            for _ in 0..20 {
+                let old = pts[v];
+                for d in 0..3 {
+                    pts[v][d] += rng.random_range(-0.09..0.09);
+                }
+                if all_positive(&pts, &c.tets) {
+                    break;
+                }
+                pts[v] = old;
+            }
+        }
+        let m0 = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+        let q0 = min_q(&m0);
+        drop(m0);
+        let (pts2, tets2, st) =
+            improve_linear(pts.clone(), c.tets.clone(), &bnd, &LinearParams::default());
+        assert!(st.max_skewness[1] < st.max_skewness[0], "{st:?}");
+        assert!((st.max_skewness[0] - (1.0 - q0)).abs() < 1e-12);
+        assert!(st.edge_removals + st.flips23 + st.smoothings + st.contractions > 0);
+        // Boundary points bit-identical, boundary faces the same, every tet positive.
+        for (a, b) in pts[..c.n_surf].iter().zip(&pts2[..c.n_surf]) {
+            assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        }
+        assert_eq!(boundary_faces(&c.tets), boundary_faces(&tets2));
+        assert!(all_positive(&pts2, &tets2));
+        // The P2 mesh is conforming, fills the cube and is certified valid.
+        let mesh = crate::mesh::build::assemble(&pts2, &tets2, c.n_surf, &c.tris, &[]);
+        let conf = crate::mesh::check::check_conformity(&mesh).unwrap();
+        assert!((conf.volume_linear - 1.0).abs() < 1e-12);
+        assert!(crate::mesh::quality::uncertified(&mesh).is_empty());
+        // Deterministic.
+        let (pts3, tets3, _) = improve_linear(pts, c.tets.clone(), &bnd, &LinearParams::default());
+        assert_eq!(tets2, tets3);
+        assert!(pts2
+            .iter()
+            .zip(&pts3)
+            .all(|(a, b)| a.map(f64::to_bits) == b.map(f64::to_bits)));
+    }
+}
