@@ -34,6 +34,9 @@ enum Cmd {
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
+        /// Draw the scaled-Jacobian and skewness histograms of a volume mesh as SVG here.
+        #[arg(long)]
+        plot: Option<PathBuf>,
     },
     /// Convert a mesh between formats (by extension: .msh .vtu .vtk .mesh).
     Convert {
@@ -94,6 +97,9 @@ struct MeshOptions {
     /// Write the quality report as JSON here.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Draw the scaled-Jacobian and skewness histograms as SVG here.
+    #[arg(long)]
+    plot: Option<PathBuf>,
     /// On failure, write what was meshed anyway (for debugging).
     #[arg(long)]
     keep_partial: bool,
@@ -148,7 +154,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match cli.cmd {
         Cmd::Mesh(a) => cmd_mesh(&a),
-        Cmd::Check { file, json } => cmd_check(&file, json),
+        Cmd::Check { file, json, plot } => cmd_check(&file, json, plot.as_deref()),
         Cmd::Convert {
             input,
             output,
@@ -247,6 +253,9 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
         r.quality.max_dihedral.max,
     );
     eprintln!("wrote {}", output.display());
+    if let Some(p) = &m.plot {
+        write_plot(p, r, &output.display().to_string())?;
+    }
     if let Some(path) = &m.report {
         let json = serde_json::json!({
             "input_triangles": surface.triangles().len(),
@@ -324,7 +333,14 @@ fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> 
     Ok(())
 }
 
-fn cmd_check(path: &Path, json: bool) -> Result<(), Error> {
+fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Error> {
+    let svg = curvetet::mesh::plot::quality_svg(report, title);
+    std::fs::write(path, svg).map_err(|e| Error::io(path, e))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+fn cmd_check(path: &Path, json: bool, plot: Option<&Path>) -> Result<(), Error> {
     let raw = io::read(path)?;
     let name = path.display().to_string();
     if raw.tet10.is_empty() && raw.tet4.is_empty() {
@@ -362,6 +378,9 @@ fn cmd_check(path: &Path, json: bool) -> Result<(), Error> {
     let m: TetMesh = raw.into_tet_mesh()?;
     let conf = check::check_conformity(&m)?;
     let report = QualityReport::of(&m);
+    if let Some(p) = plot {
+        write_plot(p, &report, &name)?;
+    }
     let rel = (conf.volume_linear - conf.enclosed_linear).abs() / conf.enclosed_linear.abs();
     let ok = report.num_invalid == 0 && rel <= 1e-10;
     if json {

@@ -22,4 +22,5 @@ pub struct TetMesh {
 
 pub mod build;
 pub mod check;
+pub mod plot;
 pub mod quality;
