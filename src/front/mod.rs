@@ -9,6 +9,7 @@
 //! curved boundary, the certified Jacobian test. New faces that coincide with front
 //! faces close them.
 
+mod cavity;
 mod grid;
 mod repair;
 pub mod size;
@@ -51,6 +52,8 @@ pub struct FrontStats {
     pub repairs: u64,
     /// Tets deleted by repairs.
     pub deleted: u64,
+    /// Stuck cavities closed by the exact search.
+    pub cavities: u64,
 }
 
 #[derive(Clone, Copy)]
@@ -83,6 +86,11 @@ struct Cand {
 }
 
 const NEW: u32 = u32::MAX;
+thread_local! { static LEVEL: std::cell::RefCell<u8> = const { std::cell::RefCell::new(0) }; }
+/// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
+/// thinner one could only be closed by a flat tet with a curved face, which is invalid
+/// on concave boundaries, and boundary faces can never be remeshed.
+const MIN_BOUNDARY_GAP_DEG: f64 = 5.0;
 thread_local! { pub static FAILS: std::cell::RefCell<[[u64;4];3]> = const { std::cell::RefCell::new([[0;4];3]) }; }
 
 #[inline]
@@ -180,7 +188,22 @@ impl<'a> Mesher<'a> {
         m
     }
 
+    fn trace(&self, what: &str, v: [u32; 3]) {
+        if let Ok(t) = std::env::var("CURVETET_TRACE") {
+            let set: Vec<u32> = t.split(',').filter_map(|x| x.parse().ok()).collect();
+            if v.iter().all(|x| set.contains(x)) {
+                eprintln!(
+                    "TRACE {what} {:?} step {} tets {}",
+                    v,
+                    self.stats.steps,
+                    self.tets.len()
+                );
+            }
+        }
+    }
+
     fn add_face(&mut self, v: [u32; 3]) {
+        self.trace("add", v);
         let id = self.faces.len() as u32;
         let k = key3(v);
         let btri = if v.iter().all(|&x| (x as usize) < self.n_surf) {
@@ -220,6 +243,7 @@ impl<'a> Mesher<'a> {
         }
         f.alive = false;
         let v = f.v;
+        self.trace("kill", v);
         self.face_map.remove(&key3(v));
         for &x in &v {
             let xi = x as usize;
@@ -330,7 +354,14 @@ impl<'a> Mesher<'a> {
                     .push(Reverse((tries + 1, Key(face_size(&p)), fid)));
                 continue;
             }
-            // Stuck at every level: remesh around it.
+            // Stuck at every level: close its cavity exactly if it is small...
+            if let Some(comp) = self.component(fid, cavity::MAX_CAVITY_FACES) {
+                if self.fill_cavity(&comp) {
+                    self.stats.cavities += 1;
+                    continue;
+                }
+            }
+            // ...else remesh around it.
             if self.stats.repairs >= max_repairs {
                 return Err(self.stuck_error(fid, "repair limit reached"));
             }
@@ -387,10 +418,11 @@ impl<'a> Mesher<'a> {
                                 .filter(|&&k| k != i)
                                 .map(|&k| FaceRef {
                                     v: self.faces[k as usize].v,
+                                    boundary: self.faces[k as usize].btri != u32::MAX,
                                 })
                                 .collect();
                             let pts = &self.pts;
-                            let v = validity::check(t, tp, &near, |x: u32| pts[x as usize]);
+                            let v = validity::check(t, tp, &near, |x: u32| pts[x as usize], 0.0);
                             let w = validity::WHY.with(|w| w.borrow().clone());
                             let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
                             let o = orient3d(tp[0], tp[1], tp[2], tp[3]);
@@ -431,6 +463,7 @@ impl<'a> Mesher<'a> {
 
     /// Try to build a tet on front face `fid` at relaxation `level`. True on success.
     fn advance(&mut self, fid: u32, level: u8) -> bool {
+        LEVEL.with(|l| *l.borrow_mut() = level);
         let f = self.faces[fid as usize];
         let fp = self.face_pts(fid);
         let c = centroid3(fp[0], fp[1], fp[2]);
@@ -569,10 +602,16 @@ impl<'a> Mesher<'a> {
             if i != fid {
                 self.near.push(FaceRef {
                     v: self.faces[i as usize].v,
+                    boundary: self.faces[i as usize].btri != u32::MAX,
                 });
             }
         }
         self.near_ids = near_ids;
+        let prox = match level {
+            0 => 0.35 * target,
+            1 => 0.2 * target,
+            _ => 0.0,
+        };
         let mut chosen = None;
         if cands.is_empty() {
             FAILS.with(|f| f.borrow_mut()[level as usize][0] += 1);
@@ -583,11 +622,12 @@ impl<'a> Mesher<'a> {
             let tp = [fp[0], fp[1], fp[2], cd.p];
             let pts = &self.pts;
             let pos = |i: u32| pts[i as usize];
-            let Some(verdict) = validity::check(t, tp, &self.near, pos) else {
+            let Some(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
                 FAILS.with(|f| f.borrow_mut()[level as usize][1] += 1);
                 continue;
             };
-            if verdict.min_gap_deg < min_gap {
+            if verdict.min_gap_deg < min_gap || verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG
+            {
                 FAILS.with(|f| f.borrow_mut()[level as usize][2] += 1);
                 continue;
             }
@@ -596,6 +636,22 @@ impl<'a> Mesher<'a> {
                     FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
                     continue;
                 }
+            }
+            // Look ahead: every thin wedge T leaves must be closable by a valid tet.
+            let closable = verdict.closings[..verdict.num_closings].iter().all(|c| {
+                let ct = c.map(|v| {
+                    if v == u32::MAX - 1 {
+                        cd.p
+                    } else {
+                        self.pts[v as usize]
+                    }
+                });
+                orient3d(ct[0], ct[1], ct[2], ct[3]) > 0
+                    && self.p2_nodes(*c, &ct).is_none_or(|x| curved_valid(&x))
+            });
+            if !closable && level < 2 {
+                FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
+                continue;
             }
             chosen = Some(*cd);
             break;
@@ -607,7 +663,7 @@ impl<'a> Mesher<'a> {
                 let t = [f.v[0], f.v[1], f.v[2], apex];
                 let tp = [fp[0], fp[1], fp[2], cd.p];
                 let pts = &self.pts;
-                let v = validity::check(t, tp, &self.near, |i: u32| pts[i as usize]);
+                let v = validity::check(t, tp, &self.near, |i: u32| pts[i as usize], 0.0);
                 let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
                 let w = validity::WHY.with(|w| w.borrow().clone());
                 why.push(format!(
@@ -657,6 +713,17 @@ impl<'a> Mesher<'a> {
     }
 
     fn insert_tet(&mut self, t: [u32; 4], base: u32) {
+        if let Ok(tr) = std::env::var("CURVETET_TRACE") {
+            let set: Vec<u32> = tr.split(',').filter_map(|x| x.parse().ok()).collect();
+            if t.iter().filter(|x| set.contains(x)).count() >= 3 {
+                eprintln!(
+                    "TRACE tet {:?} base {:?} level {}",
+                    t,
+                    self.faces[base as usize].v,
+                    LEVEL.with(|l| *l.borrow())
+                );
+            }
+        }
         let tp = [0, 1, 2, 3].map(|k| self.pts[t[k] as usize]);
         self.volume_done += tet_det(tp[0], tp[1], tp[2], tp[3]) / 6.0;
         self.tets.push(t);
