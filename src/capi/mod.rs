@@ -56,7 +56,9 @@ const _: () = {
 /// header it was built with). A static string: never free it.
 #[no_mangle]
 pub extern "C" fn curvetet_version() -> *const c_char {
-    concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast()
+    value_call("curvetet_version", c"".as_ptr(), || {
+        Ok(concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast())
+    })
 }
 
 /// The message of the last failed curvetet call on this thread, "" when the last
@@ -64,7 +66,10 @@ pub extern "C" fn curvetet_version() -> *const c_char {
 /// the library and valid until the next curvetet call on this thread; copy it to keep it.
 #[no_mangle]
 pub extern "C" fn curvetet_last_error_message() -> *const c_char {
-    status::last_error_ptr()
+    // last_error_ptr cannot panic (try_with, try_borrow); the guard is for uniformity.
+    value_call("curvetet_last_error_message", c"".as_ptr(), || {
+        Ok(status::last_error_ptr())
+    })
 }
 
 /// The name of a status code as a static string ("CURVETET_OK",
@@ -72,10 +77,12 @@ pub extern "C" fn curvetet_last_error_message() -> *const c_char {
 /// not one. Never NULL; never free it.
 #[no_mangle]
 pub extern "C" fn curvetet_error_name(status: StatusArg) -> *const c_char {
-    match curvetet_status::from_int(status.0) {
-        Some(s) => s.name().as_ptr(),
-        None => c"CURVETET_UNKNOWN_STATUS".as_ptr(),
-    }
+    value_call("curvetet_error_name", c"".as_ptr(), || {
+        Ok(match curvetet_status::from_int(status.0) {
+            Some(s) => s.name().as_ptr(),
+            None => c"CURVETET_UNKNOWN_STATUS".as_ptr(),
+        })
+    })
 }
 
 /// Fill `*out` with the default options (alpha 1.5, graded size, optimize on, all cores,
