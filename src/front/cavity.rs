@@ -14,9 +14,9 @@ use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::*;
 
 /// Largest cavity (front faces) the exact search takes on.
-pub(super) const MAX_CAVITY_FACES: usize = 160;
+pub(super) const MAX_CAVITY_FACES: usize = 40;
 /// Search nodes per cavity.
-const NODE_BUDGET: usize = 4000;
+const NODE_BUDGET: usize = 300;
 /// Id used for the Steiner point during the search.
 const STEINER: u32 = u32::MAX - 2;
 

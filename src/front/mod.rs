@@ -86,6 +86,7 @@ struct Cand {
 }
 
 const NEW: u32 = u32::MAX;
+thread_local! { pub static NEARSTAT: std::cell::RefCell<[[u64;3];3]> = const { std::cell::RefCell::new([[0;3];3]) }; }
 thread_local! { static LEVEL: std::cell::RefCell<u8> = const { std::cell::RefCell::new(0) }; }
 /// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
 /// thinner one could only be closed by a flat tet with a curved face, which is invalid
@@ -311,7 +312,7 @@ impl<'a> Mesher<'a> {
             self.stats.steps += 1;
             if self.stats.steps % 20000 == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
                 let open = self.faces.iter().filter(|f| f.alive).count();
-                eprintln!("fails {:?}", FAILS.with(|f| *f.borrow()));
+                eprintln!("fails {:?} near {:?}", FAILS.with(|f| *f.borrow()), NEARSTAT.with(|f| *f.borrow()));
                 eprintln!(
                     "step {} tets {} pts {} open {} tries {} stats {:?} vol {:.4}",
                     self.stats.steps,
@@ -481,13 +482,16 @@ impl<'a> Mesher<'a> {
             normalize(flat_n)
         };
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let target = self.size.at(c).clamp(0.55 * lf, 1.8 * lf);
+        let l_field = self.size.at(c);
+        let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);
         let a = axpy(c, h, n);
         let (radius, min_new_dist) = match level {
-            0 => (self.opts.alpha * h, 0.45 * target),
-            1 => (2.0 * self.opts.alpha * h, 0.25 * target),
-            _ => (3.0 * self.opts.alpha * h, 0.0),
+            // New points keep away from existing ones by a fraction of the *field* size,
+            // so a pocket of small faces cannot breed ever smaller elements.
+            0 => (self.opts.alpha * h, 0.45 * l_field),
+            1 => (2.0 * self.opts.alpha * h, 0.35 * l_field),
+            _ => (3.0 * self.opts.alpha * h, 0.25 * l_field),
         };
         // Candidate existing vertices.
         let found = self
@@ -518,8 +522,8 @@ impl<'a> Mesher<'a> {
         // New points: the ideal one, and lower ones when relaxing.
         let heights: &[f64] = match level {
             0 => &[1.0],
-            1 => &[1.0, 0.6, 0.35],
-            _ => &[1.0, 0.6, 0.35, 0.2],
+            1 => &[1.0, 0.7],
+            _ => &[1.0, 0.7, 0.5],
         };
         for &s in heights {
             let p = axpy(c, s * h, n);
@@ -607,6 +611,8 @@ impl<'a> Mesher<'a> {
             }
         }
         self.near_ids = near_ids;
+        if self.near.len() > 400 && std::env::var_os("CURVETET_DEBUG4").is_some() { eprintln!("big near {} bb {:?} cands {} h {} fp {:?}", self.near.len(), bb, cands.len(), h, fp); }
+        NEARSTAT.with(|n| { let mut n = n.borrow_mut(); n[level as usize][0] += 1; n[level as usize][1] += self.near.len() as u64; n[level as usize][2] += cands.len() as u64; });
         let prox = match level {
             0 => 0.35 * target,
             1 => 0.2 * target,
