@@ -63,7 +63,16 @@ struct Face {
     tries: u8,
     /// Index of the input triangle when this face is a boundary face, else u32::MAX.
     btri: u32,
+    /// Version: queue entries with an older version are stale.
+    ver: u32,
 }
+
+/// A queue entry: (tries, class, key, face, version); smallest first.
+type QEntry = Reverse<(u8, u8, Key, u32, u32)>;
+
+/// Wedges (unmeshed dihedral angle between neighbouring front faces) below this are
+/// closed first: left for later they become the pockets an advancing front gets stuck in.
+const WEDGE_FIRST_DEG: f64 = 75.0;
 
 /// Ordered f64 for the queue.
 #[derive(Clone, Copy, PartialEq, PartialOrd)]
@@ -116,7 +125,9 @@ pub(crate) struct Mesher<'a> {
     face_map: HashMap<[u32; 3], u32>,
     btri_map: HashMap<[u32; 3], u32>,
     bedge_mid: HashMap<(u32, u32), u32>,
-    heap: BinaryHeap<Reverse<(u8, Key, u32)>>,
+    heap: BinaryHeap<QEntry>,
+    /// Directed edge (a, b) of a live front face -> that face.
+    edges: HashMap<(u32, u32), u32>,
     grid: FaceGrid,
     vtree: MutableKdTree<f64, 3>,
     tets: Vec<[u32; 4]>,
@@ -168,6 +179,7 @@ impl<'a> Mesher<'a> {
             btri_map: HashMap::with_capacity(surf_tris.len()),
             bedge_mid,
             heap: BinaryHeap::new(),
+            edges: HashMap::with_capacity(surf_tris.len() * 6),
             grid: FaceGrid::new(lo, cell),
             vtree: MutableKdTree::default(),
             tets: Vec::new(),
@@ -217,7 +229,11 @@ impl<'a> Mesher<'a> {
             alive: true,
             tries: 0,
             btri,
+            ver: 0,
         });
+        for k in 0..3 {
+            self.edges.insert((v[k], v[(k + 1) % 3]), id);
+        }
         self.face_map.insert(k, id);
         let p = [
             self.pts[v[0] as usize],
@@ -233,8 +249,53 @@ impl<'a> Mesher<'a> {
                 let _ = self.vtree.add(&self.pts[xi], x);
             }
         }
-        let key = face_size(&p);
-        self.heap.push(Reverse((0, Key(key), id)));
+        self.enqueue(id);
+        // The neighbours' wedges changed.
+        for k in 0..3 {
+            if let Some(&g) = self.edges.get(&(v[(k + 1) % 3], v[k])) {
+                self.faces[g as usize].ver += 1;
+                self.enqueue(g);
+            }
+        }
+    }
+
+    /// Unmeshed dihedral angle (degrees) at the edge shared by live faces `f` and `g`.
+    fn wedge_deg(&self, f: u32, g: u32) -> f64 {
+        let fv = self.faces[f as usize].v;
+        let gv = self.faces[g as usize].v;
+        let fp = fv.map(|x| self.pts[x as usize]);
+        let gp = gv.map(|x| self.pts[x as usize]);
+        let n1 = normalize(tri_normal(fp[0], fp[1], fp[2]));
+        let n2 = normalize(tri_normal(gp[0], gp[1], gp[2]));
+        let theta = (-dot(n1, n2)).clamp(-1.0, 1.0).acos().to_degrees();
+        let Some(&d) = gv.iter().find(|x| !fv.contains(x)) else {
+            return 360.0;
+        };
+        if orient3d(fp[0], fp[1], fp[2], self.pts[d as usize]) > 0 {
+            theta
+        } else {
+            360.0 - theta
+        }
+    }
+
+    /// Queue live face `id` under its current version: faces in a thin wedge with a
+    /// neighbour first (thinnest first), then smallest first.
+    fn enqueue(&mut self, id: u32) {
+        let f = self.faces[id as usize];
+        let mut wedge = 360.0f64;
+        for k in 0..3 {
+            if let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) {
+                wedge = wedge.min(self.wedge_deg(id, g));
+            }
+        }
+        let p = self.face_pts(id);
+        let (class, key) = if wedge < WEDGE_FIRST_DEG {
+            (0, wedge)
+        } else {
+            (1, face_size(&p))
+        };
+        self.heap
+            .push(Reverse((f.tries, class, Key(key), id, f.ver)));
     }
 
     fn kill_face(&mut self, id: u32) {
@@ -245,6 +306,12 @@ impl<'a> Mesher<'a> {
         f.alive = false;
         let v = f.v;
         self.trace("kill", v);
+        for k in 0..3 {
+            let e = (v[k], v[(k + 1) % 3]);
+            if self.edges.get(&e) == Some(&id) {
+                self.edges.remove(&e);
+            }
+        }
         self.face_map.remove(&key3(v));
         for &x in &v {
             let xi = x as usize;
@@ -304,15 +371,19 @@ impl<'a> Mesher<'a> {
         let max_steps = 200 * self.surf_tris.len() as u64 + 1_000_000;
         let max_repairs = 50 + self.surf_tris.len() as u64;
         let mut last_report = 0.0;
-        while let Some(Reverse((tries, _, fid))) = self.heap.pop() {
+        while let Some(Reverse((tries, _, _, fid, ver))) = self.heap.pop() {
             let f = self.faces[fid as usize];
-            if !f.alive || f.tries != tries {
+            if !f.alive || f.tries != tries || f.ver != ver {
                 continue;
             }
             self.stats.steps += 1;
             if self.stats.steps % 20000 == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
                 let open = self.faces.iter().filter(|f| f.alive).count();
-                eprintln!("fails {:?} near {:?}", FAILS.with(|f| *f.borrow()), NEARSTAT.with(|f| *f.borrow()));
+                eprintln!(
+                    "fails {:?} near {:?}",
+                    FAILS.with(|f| *f.borrow()),
+                    NEARSTAT.with(|f| *f.borrow())
+                );
                 eprintln!(
                     "step {} tets {} pts {} open {} tries {} stats {:?} vol {:.4}",
                     self.stats.steps,
@@ -349,10 +420,10 @@ impl<'a> Mesher<'a> {
                 continue;
             }
             if tries < 3 {
-                self.faces[fid as usize].tries = tries + 1;
-                let p = self.face_pts(fid);
-                self.heap
-                    .push(Reverse((tries + 1, Key(face_size(&p)), fid)));
+                let f = &mut self.faces[fid as usize];
+                f.tries = tries + 1;
+                f.ver += 1;
+                self.enqueue(fid);
                 continue;
             }
             // Stuck at every level: close its cavity exactly if it is small...
@@ -611,8 +682,22 @@ impl<'a> Mesher<'a> {
             }
         }
         self.near_ids = near_ids;
-        if self.near.len() > 400 && std::env::var_os("CURVETET_DEBUG4").is_some() { eprintln!("big near {} bb {:?} cands {} h {} fp {:?}", self.near.len(), bb, cands.len(), h, fp); }
-        NEARSTAT.with(|n| { let mut n = n.borrow_mut(); n[level as usize][0] += 1; n[level as usize][1] += self.near.len() as u64; n[level as usize][2] += cands.len() as u64; });
+        if self.near.len() > 400 && std::env::var_os("CURVETET_DEBUG4").is_some() {
+            eprintln!(
+                "big near {} bb {:?} cands {} h {} fp {:?}",
+                self.near.len(),
+                bb,
+                cands.len(),
+                h,
+                fp
+            );
+        }
+        NEARSTAT.with(|n| {
+            let mut n = n.borrow_mut();
+            n[level as usize][0] += 1;
+            n[level as usize][1] += self.near.len() as u64;
+            n[level as usize][2] += cands.len() as u64;
+        });
         let prox = match level {
             0 => 0.35 * target,
             1 => 0.2 * target,
