@@ -95,6 +95,7 @@ struct Cand {
 }
 
 const NEW: u32 = u32::MAX;
+thread_local! { pub static WHYSTAT: std::cell::RefCell<std::collections::BTreeMap<String, u64>> = const { std::cell::RefCell::new(std::collections::BTreeMap::new()) }; }
 thread_local! { pub static NEARSTAT: std::cell::RefCell<[[u64;3];3]> = const { std::cell::RefCell::new([[0;3];3]) }; }
 thread_local! { static LEVEL: std::cell::RefCell<u8> = const { std::cell::RefCell::new(0) }; }
 /// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
@@ -379,6 +380,7 @@ impl<'a> Mesher<'a> {
             self.stats.steps += 1;
             if self.stats.steps % 20000 == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
                 let open = self.faces.iter().filter(|f| f.alive).count();
+                eprintln!("why {:?}", WHYSTAT.with(|m| m.borrow().clone()));
                 eprintln!(
                     "fails {:?} near {:?}",
                     FAILS.with(|f| *f.borrow()),
@@ -708,13 +710,29 @@ impl<'a> Mesher<'a> {
             FAILS.with(|f| f.borrow_mut()[level as usize][0] += 1);
         }
         for cd in &cands {
-            let apex = if cd.id == NEW { u32::MAX - 1 } else { cd.id };
+            let apex = if cd.id == NEW {
+                validity::NEW_POINT
+            } else {
+                cd.id
+            };
             let t = [f.v[0], f.v[1], f.v[2], apex];
             let tp = [fp[0], fp[1], fp[2], cd.p];
             let pts = &self.pts;
             let pos = |i: u32| pts[i as usize];
             let Some(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
                 FAILS.with(|f| f.borrow_mut()[level as usize][1] += 1);
+                if level == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
+                    let w = validity::WHY.with(|w| w.borrow().clone());
+                    let cat: String = w
+                        .chars()
+                        .filter(|c| c.is_alphabetic() || *c == ' ')
+                        .collect::<String>()
+                        .split_whitespace()
+                        .collect::<Vec<_>>()
+                        .join(" ");
+                    let cat = format!("{}{}", if cd.id == NEW { "NEW " } else { "OLD " }, cat);
+                    WHYSTAT.with(|m| *m.borrow_mut().entry(cat).or_insert(0) += 1);
+                }
                 continue;
             };
             if verdict.min_gap_deg < min_gap || verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG
@@ -731,7 +749,7 @@ impl<'a> Mesher<'a> {
             // Look ahead: every thin wedge T leaves must be closable by a valid tet.
             let closable = verdict.closings[..verdict.num_closings].iter().all(|c| {
                 let ct = c.map(|v| {
-                    if v == u32::MAX - 1 {
+                    if v == validity::NEW_POINT {
                         cd.p
                     } else {
                         self.pts[v as usize]
@@ -750,7 +768,11 @@ impl<'a> Mesher<'a> {
         if chosen.is_none() && level == 2 && std::env::var_os("CURVETET_DEBUG2").is_some() {
             let mut why = Vec::new();
             for cd in &cands {
-                let apex = if cd.id == NEW { u32::MAX - 1 } else { cd.id };
+                let apex = if cd.id == NEW {
+                    validity::NEW_POINT
+                } else {
+                    cd.id
+                };
                 let t = [f.v[0], f.v[1], f.v[2], apex];
                 let tp = [fp[0], fp[1], fp[2], cd.p];
                 let pts = &self.pts;

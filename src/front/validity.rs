@@ -35,6 +35,9 @@ pub struct Verdict {
     pub num_closings: usize,
 }
 
+/// Id the caller gives a candidate's apex when it is a new point.
+pub const NEW_POINT: u32 = u32::MAX - 1;
+
 /// Wedges thinner than this (degrees) are checked for a valid closing tet.
 pub const LOOKAHEAD_GAP_DEG: f64 = 35.0;
 
@@ -93,7 +96,7 @@ pub fn check(
         let in_t = |id: u32| t.iter().position(|&x| x == id);
         let loc = [in_t(fv[0]), in_t(fv[1]), in_t(fv[2])];
         let shared = loc.iter().filter(|x| x.is_some()).count();
-        if shared == 0 && min_d2 > 0.0 {
+        if shared == 0 && min_d2 > 0.0 && t[3] == NEW_POINT {
             // Proximity: an unrelated front face must not come close to T's apex, nor
             // its vertices close to T's new faces (a narrow gap would be left).
             if point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2 {
