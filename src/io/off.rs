@@ -44,7 +44,10 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
                 show(first)
             )));
         }
-        if tok.get(1).is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY")) {
+        if tok
+            .get(1)
+            .is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY"))
+        {
             return Err(l.err("binary OFF is not supported; write it as ASCII OFF"));
         }
         counts = tok[1..].to_vec();
@@ -71,9 +74,8 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
         }
         let mut p = [0.0; 3];
         for d in 0..3 {
-            p[d] = parse_f64(tok[d]).ok_or_else(|| {
-                l.err(format!("vertex {i}: invalid number '{}'", show(tok[d])))
-            })?;
+            p[d] = parse_f64(tok[d])
+                .ok_or_else(|| l.err(format!("vertex {i}: invalid number '{}'", show(tok[d]))))?;
         }
         points.push(p);
     }

@@ -130,7 +130,9 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
         }
     }
     if !have_faces {
-        return Err(body.c.err_at(0, "no 'face' element with a 'vertex_indices' list"));
+        return Err(body
+            .c
+            .err_at(0, "no 'face' element with a 'vertex_indices' list"));
     }
     indexed_mesh(&points, tris, name)
 }
@@ -148,7 +150,9 @@ fn header<'a>(c: &mut Cursor<'a>) -> Result<(Encoding, Vec<Element<'a>>)> {
             return Err(c.eof("'end_header'"));
         }
         let line = c.rest_of_line();
-        let mut w = line.split(|b| b.is_ascii_whitespace()).filter(|t| !t.is_empty());
+        let mut w = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|t| !t.is_empty());
         let Some(key) = w.next() else { continue };
         match key {
             b"comment" | b"obj_info" => {}
@@ -225,8 +229,10 @@ impl Body<'_> {
     fn value(&mut self, t: Scalar, what: &str) -> Result<f64> {
         if self.encoding == Encoding::Ascii {
             let tok = self.c.expect_token(what)?;
-            return parse_f64(tok)
-                .ok_or_else(|| self.c.err(format!("invalid number '{}' for {what}", show(tok))));
+            return parse_f64(tok).ok_or_else(|| {
+                self.c
+                    .err(format!("invalid number '{}' for {what}", show(tok)))
+            });
         }
         let b = self.c.bytes(t.size(), what)?;
         Ok(t.decode(b, self.encoding == Encoding::Big))
@@ -238,7 +244,9 @@ impl Body<'_> {
         if v >= 0.0 && v.fract() == 0.0 && v <= u32::MAX as f64 {
             Ok(v as u64)
         } else {
-            Err(self.c.err(format!("{what} {v} is not a valid non-negative integer")))
+            Err(self
+                .c
+                .err(format!("{what} {v} is not a valid non-negative integer")))
         }
     }
 
@@ -280,7 +288,9 @@ impl Body<'_> {
                 .position(|p| matches!(p, Property::Scalar(_, n) if *n == want))
         };
         let (Some(ix), Some(iy), Some(iz)) = (find(b"x"), find(b"y"), find(b"z")) else {
-            return Err(self.c.err("the 'vertex' element has no scalar x, y and z properties"));
+            return Err(self
+                .c
+                .err("the 'vertex' element has no scalar x, y and z properties"));
         };
         let mut out = Vec::with_capacity(capped(e.count, self.c.remaining(), self.min_size(e)));
         for _ in 0..e.count {
@@ -366,7 +376,11 @@ mod tests {
     use super::*;
 
     fn binary(big: bool) -> Vec<u8> {
-        let fmt = if big { "binary_big_endian" } else { "binary_little_endian" };
+        let fmt = if big {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
         let mut v = format!(
             "ply\nformat {fmt} 1.0\ncomment x\nelement vertex 3\nproperty float x\n\
              property float y\nproperty double z\nproperty list uchar int extra\n\
@@ -374,9 +388,27 @@ mod tests {
              end_header\n"
         )
         .into_bytes();
-        let f32b = |x: f32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
-        let f64b = |x: f64| if big { x.to_be_bytes() } else { x.to_le_bytes() };
-        let u32b = |x: u32| if big { x.to_be_bytes() } else { x.to_le_bytes() };
+        let f32b = |x: f32| {
+            if big {
+                x.to_be_bytes()
+            } else {
+                x.to_le_bytes()
+            }
+        };
+        let f64b = |x: f64| {
+            if big {
+                x.to_be_bytes()
+            } else {
+                x.to_le_bytes()
+            }
+        };
+        let u32b = |x: u32| {
+            if big {
+                x.to_be_bytes()
+            } else {
+                x.to_le_bytes()
+            }
+        };
         for p in [[0.1f32, 0.0], [1.0, 0.0], [0.0, 1.0]] {
             v.extend(f32b(p[0]));
             v.extend(f32b(p[1]));
@@ -406,7 +438,8 @@ mod tests {
 
     #[test]
     fn ascii_with_quads() {
-        let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n\
+        let text =
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n\
                     property double z\nelement face 1\nproperty list uchar int vertex_index\n\
                     end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
         let m = read(text.as_bytes(), "t.ply").unwrap();

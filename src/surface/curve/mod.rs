@@ -11,8 +11,8 @@
 //!    self-intersection.
 //! 2. **Reconstruction** (`sectors`, `tangents`): face normals; feature edges, whose
 //!    dihedral angle exceeds [`CurveOptions::feature_angle_deg`]; per vertex, one normal
-//!    per smooth sector of its fan (angle-weighted), so normals never average across a
-//!    sharp edge; per smooth feature-curve vertex, the curve's tangent (circle through it
+//!    per smooth sector of its fan (Max's weights, exact on spheres; see
+//!    [`NormalWeights`]), so normals never average across a sharp edge; per smooth feature-curve vertex, the curve's tangent (circle through it
 //!    and its two curve neighbours).
 //! 3. **Mid nodes** (`midpoint`), one per edge:
 //!    - an edge whose two end sectors are exactly planar (exact predicate) stays straight:
@@ -32,10 +32,12 @@
 //! Input vertices keep their index and their bit-exact coordinates; mid nodes follow them,
 //! one per edge in sorted (smaller vertex, larger vertex) order.
 //!
-//! **Why the arc rule** (measured on the benchmark surfaces, `tests/curve.rs`): on the
-//! sphere (h = 0.2) and the torus (h = 0.14) its mid nodes are closer to the true surface
-//! than PN triangles' midpoints, and the enclosed-volume error falls well over tenfold
-//! relative to the linear surface (numbers in the README).
+//! **Why the arc rule** (measured on the benchmark surfaces, `tests/curve.rs`, Max
+//! normals): on the sphere (h = 0.2) the arc rule puts every mid node on the sphere (max
+//! distance 2.2e-16; PN: 1.6e-4) and cuts the linear surface's volume error 508-fold (PN:
+//! 98-fold); on the torus (h = 0.14), max distance 8.2e-4 (PN 9.7e-4) and 162-fold (PN
+//! 39-fold). With exact normals the arc rule is exact on any circle, the PN midpoint is
+//! not.
 
 mod check;
 mod guard;
@@ -62,6 +64,29 @@ pub enum MidpointRule {
     PnTriangle,
 }
 
+/// How the normal of a vertex (of one smooth sector of its fan) is averaged from its
+/// triangles' normals. Measured on the benchmark surfaces (`tests/curve.rs`, arc rule):
+///
+/// | surface | `Max`: volume error ratio linear/curved, max mid-node distance | `Angle` |
+/// |---|---|---|
+/// | sphere (analytic) | 508x, 2.2e-16 | 129x, 1.3e-3 |
+/// | torus (analytic) | 162x, 8.2e-4 | 89x, 1.4e-3 |
+/// | tube (cylinder mid nodes' radius error) | 5.6e-4 | 7.8e-4 |
+/// | screw (volume error vs CAD) | 0.29 % | 0.15 % |
+/// | hinge (min curved/chord normal cosine) | 0.56 | 0.79 |
+///
+/// `Max` is the default: best on the analytic surfaces. Its weights grow as 1/(edge
+/// length)^2, so on meshes that mix very small and large triangles the small ones
+/// dominate; `Angle` is the more even-handed choice there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NormalWeights {
+    /// Max (1999): (u x w) / (|u|^2 |w|^2) per wedge; exact on spheres.
+    #[default]
+    Max,
+    /// Angle-weighted face normals (Thürmer & Wüthrich 1998).
+    Angle,
+}
+
 /// Options of [`curve_linear`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CurveOptions {
@@ -77,6 +102,8 @@ pub struct CurveOptions {
     pub min_normal_cosine: f64,
     /// How smooth edges are curved. Default [`MidpointRule::Arc`].
     pub rule: MidpointRule,
+    /// How vertex normals are averaged. Default [`NormalWeights::Max`].
+    pub normals: NormalWeights,
 }
 
 impl Default for CurveOptions {
@@ -85,6 +112,7 @@ impl Default for CurveOptions {
             feature_angle_deg: 40.0,
             min_normal_cosine: 0.25,
             rule: MidpointRule::Arc,
+            normals: NormalWeights::Max,
         }
     }
 }
@@ -169,7 +197,7 @@ pub fn curve_linear_report(
     } = lifted;
     let cos_feature = opts.feature_angle_deg.to_radians().cos();
     let fnormal = sectors::face_normals(&nodes, &tris);
-    let sec = sectors::sectors(&nodes, &tris, &edges, &fnormal, cos_feature);
+    let sec = sectors::sectors(&nodes, &tris, &edges, &fnormal, cos_feature, opts.normals);
     let curve = tangents::feature_tangents(&nodes, n_input, &edges, &sec.feature, cos_feature);
     let mut report = CurveReport {
         edges: edges.len(),
@@ -212,7 +240,12 @@ pub fn curve_linear_report(
                 match opts.rule {
                     MidpointRule::Arc => {
                         let d = sub(pb, pa);
-                        arc_mid(pa, pb, tangent_from_normal(d, na), tangent_from_normal(d, nb))
+                        arc_mid(
+                            pa,
+                            pb,
+                            tangent_from_normal(d, na),
+                            tangent_from_normal(d, nb),
+                        )
                     }
                     MidpointRule::PnTriangle => pn_mid(pa, pb, na, nb),
                 }

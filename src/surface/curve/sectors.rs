@@ -10,15 +10,19 @@
 //! wedges), so a vertex on a feature curve has one sector per side, a smooth vertex (or
 //! one where a feature line ends) a single sector.
 //!
-//! **Sector normal**: the angle-weighted mean of its triangles' normals (Thürmer & Wüthrich
-//! 1998), which does not depend on how the fan happens to be triangulated.
+//! **Sector normal**: a weighted mean of its triangles' normals, by default with Max's
+//! weights (N. Max, "Weights for computing vertex normals from facet normals", 1999):
+//! sum of (u x w) / (|u|^2 |w|^2) over the wedges with edge vectors u, w, exact for
+//! vertices on a sphere however the fan is triangulated; or angle-weighted (Thürmer &
+//! Wüthrich 1998). See [`NormalWeights`] for what each measured.
 //!
 //! **Planar sector**: every corner of its triangles lies exactly (orient3d == 0) in the
 //! plane of its first triangle. Edges whose both end sectors are planar stay exactly
 //! straight: flat regions stay flat.
 
+use super::NormalWeights;
 use crate::geom::predicates::orient3d;
-use crate::geom::vec3::{cross, dot, norm, normalize, scale, sub};
+use crate::geom::vec3::{cross, dot, norm, norm2, normalize, scale, sub};
 use crate::geom::P3;
 use crate::surface::topology::SurfaceEdge;
 
@@ -79,6 +83,7 @@ pub(crate) fn sectors(
     edges: &[SurfaceEdge],
     fnormal: &[P3],
     cos_feature: f64,
+    weights: NormalWeights,
 ) -> Sectors {
     let feature: Vec<bool> = edges
         .iter()
@@ -128,10 +133,13 @@ pub(crate) fn sectors(
                 sub(nodes[tri[(i + 1) % 3] as usize], p),
                 sub(nodes[tri[(i + 2) % 3] as usize], p),
             );
-            let angle = norm(cross(u, w)).atan2(dot(u, w));
-            let n = fnormal[t];
+            let (n, wgt) = match weights {
+                // (u x w) / (|u|^2 |w|^2) = n sin(angle) / (|u| |w|).
+                NormalWeights::Max => (cross(u, w), 1.0 / (norm2(u) * norm2(w))),
+                NormalWeights::Angle => (fnormal[t], norm(cross(u, w)).atan2(dot(u, w))),
+            };
             for d in 0..3 {
-                sum[s][d] += angle * n[d];
+                sum[s][d] += wgt * n[d];
             }
             if first_tri[s] == u32::MAX {
                 first_tri[s] = t as u32;
