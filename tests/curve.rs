@@ -182,3 +182,42 @@ fn hinge_and_screw_curve_without_folds() {
         assert_eq!(&s.nodes()[..raw.nodes.len()], &raw.nodes[..]);
     }
 }
+
+/// Curve, then mesh end to end to a certified-valid P2 mesh (the sphere, a smooth case).
+#[test]
+fn sphere_curves_then_meshes() {
+    let (_, s, _) = curve("sphere", &CurveOptions::default());
+    let g = curvetet::generate(&s, &curvetet::Options::default())
+        .unwrap_or_else(|e| panic!("sphere: {e}"));
+    eprintln!(
+        "sphere: {} tets, min certified SJ {:.3}",
+        g.report.num_tets, g.report.quality.scaled_jacobian_certified.min
+    );
+    assert_eq!(g.report.num_invalid, 0);
+    assert_eq!(g.mesh.boundary.len(), s.triangles().len());
+}
+
+/// Curve, then mesh the sharp-featured surfaces end to end.
+///
+/// Ignored: the curving succeeds (see `hinge_and_screw_curve_without_folds`), but the
+/// advancing front cannot close these surfaces yet (2026-11-22: screw "repair limit
+/// reached ... 78 front faces remain open", hinge "step limit reached ... 2138 front faces
+/// remain open"; the mesher is being made robust in another branch). Un-ignore when it is.
+#[test]
+#[ignore = "the advancing front cannot close the screw and hinge yet (mesher robustness)"]
+fn hinge_and_screw_curve_then_mesh() {
+    for name in ["hinge", "screw"] {
+        let (_, s, _) = curve(name, &CurveOptions::default());
+        let t = std::time::Instant::now();
+        let g = curvetet::generate(&s, &curvetet::Options::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        eprintln!(
+            "{name}: {} tets in {:.1} s, min certified SJ {:.3}",
+            g.report.num_tets,
+            t.elapsed().as_secs_f64(),
+            g.report.quality.scaled_jacobian_certified.min
+        );
+        assert_eq!(g.report.num_invalid, 0, "{name}");
+        assert_eq!(g.mesh.boundary.len(), s.triangles().len(), "{name}");
+    }
+}
