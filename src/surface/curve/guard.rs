@@ -74,7 +74,7 @@ impl Edges<'_> {
 
 fn bad_fold(nodes: &[P3], tri: &[u32; 6], min_cos: f64) -> bool {
     match min_normal_cosine_of(&tri_nodes(nodes, tri)) {
-        NormalSample::MinCos(c, _) => !(c >= min_cos),
+        NormalSample::MinCos(c, _) => c.is_nan() || c < min_cos,
         NormalSample::ChordUnderflow => false, // a chord property: reported by the checks
     }
 }
@@ -129,12 +129,12 @@ fn conflicting_mid_nodes(nodes: &[P3], tris: &[[u32; 6]], n_input: usize) -> Vec
     let visit_pair = |out: &mut Vec<u32>, i: u32, j: u32| {
         let (ti, tj) = (&tris[i as usize], &tris[j as usize]);
         let (xi, xj) = (tri_nodes(nodes, ti), tri_nodes(nodes, tj));
-        for ki in 0..4 {
+        for (ki, ski) in SUB_TRIANGLES.iter().enumerate() {
             let a = sub_ids(ti, ki);
-            let pa = SUB_TRIANGLES[ki].map(|q| xi[q]);
-            for kj in 0..4 {
+            let pa = ski.map(|q| xi[q]);
+            for (kj, skj) in SUB_TRIANGLES.iter().enumerate() {
                 let b = sub_ids(tj, kj);
-                let pb = SUB_TRIANGLES[kj].map(|q| xj[q]);
+                let pb = skj.map(|q| xj[q]);
                 if overlap(&bbox(pa), &bbox(pb))
                     && !collinear(pa[0], pa[1], pa[2])
                     && !collinear(pb[0], pb[1], pb[2])
@@ -155,14 +155,14 @@ fn conflicting_mid_nodes(nodes: &[P3], tris: &[[u32; 6]], n_input: usize) -> Vec
         .flat_map_iter(|t| {
             let x = tri_nodes(nodes, t);
             let mut o = Vec::new();
-            for k in 0..4 {
-                let pa = SUB_TRIANGLES[k].map(|q| x[q]);
+            for (k, sk) in SUB_TRIANGLES.iter().enumerate() {
+                let pa = sk.map(|q| x[q]);
                 if collinear(pa[0], pa[1], pa[2]) {
                     mids(sub_ids(t, k), &mut o);
                     continue;
                 }
-                for l in k + 1..4 {
-                    let pb = SUB_TRIANGLES[l].map(|q| x[q]);
+                for (l, sl) in SUB_TRIANGLES.iter().enumerate().skip(k + 1) {
+                    let pb = sl.map(|q| x[q]);
                     if !collinear(pb[0], pb[1], pb[2])
                         && flat_conflict_at(pa, sub_ids(t, k), pb, sub_ids(t, l))
                     {

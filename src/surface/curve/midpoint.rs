@@ -33,7 +33,7 @@ pub(crate) fn arc_mid(a: P3, b: P3, ta: Option<P3>, tb: Option<P3>) -> P3 {
     let m = mid(a, b);
     let chord = sub(b, a);
     let l = norm(chord);
-    if !(l > 0.0) {
+    if l.is_nan() || l <= 0.0 {
         return m;
     }
     let d = scale(chord, 1.0 / l);
@@ -44,7 +44,7 @@ pub(crate) fn arc_mid(a: P3, b: P3, ta: Option<P3>, tb: Option<P3>) -> P3 {
         (None, None) => return m,
     };
     let s = norm(v);
-    if !(s > 0.0) || !s.is_finite() {
+    if !s.is_finite() || s <= 0.0 {
         return m;
     }
     let phi = s.min(1.0).asin();

@@ -133,7 +133,10 @@ impl CurveOptions {
                 self.feature_angle_deg
             )));
         }
-        if !(self.min_normal_cosine > 0.0 && self.min_normal_cosine <= 1.0) {
+        if self.min_normal_cosine.is_nan()
+            || self.min_normal_cosine <= 0.0
+            || self.min_normal_cosine > 1.0
+        {
             return Err(Error::InvalidArgument(format!(
                 "min_normal_cosine {}: must be in (0, 1]",
                 self.min_normal_cosine

@@ -54,7 +54,12 @@ pub(crate) fn feature_tangents(
             let x = nodes[v];
             let (e1, e2) = (sub(x, nodes[p as usize]), sub(nodes[q as usize], x));
             let (l1, l2) = (norm(e1), norm(e2));
-            if !(l1 > 0.0 && l2 > 0.0) || dot(e1, e2) < cos_feature * l1 * l2 {
+            if l1.is_nan()
+                || l2.is_nan()
+                || l1 <= 0.0
+                || l2 <= 0.0
+                || dot(e1, e2) < cos_feature * l1 * l2
+            {
                 return None; // a kink
             }
             let t: P3 = [0, 1, 2].map(|d| l2 / l1 * e1[d] + l1 / l2 * e2[d]);
