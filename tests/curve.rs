@@ -221,3 +221,70 @@ fn hinge_and_screw_curve_then_mesh() {
         assert_eq!(g.mesh.boundary.len(), s.triangles().len(), "{name}");
     }
 }
+
+/// Mangled linear surfaces (vertices moved by random amounts, some far enough to fold or
+/// cross the surface; triangles with swapped corners) never panic; whatever is accepted
+/// passes the guards' normal-cosine bound.
+#[test]
+fn mangled_surfaces_never_panic() {
+    let raw = read_lin("screw");
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut rnd = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut ok, mut err) = (0, 0);
+    for k in 0..40 {
+        let mut nodes = raw.nodes.clone();
+        let mut tris = raw.tri3.clone();
+        let amp = [1e-9, 1e-3, 0.5, 5.0][k % 4];
+        for _ in 0..1 + k % 5 {
+            let v = (rnd() * nodes.len() as f64) as usize % nodes.len();
+            for d in 0..3 {
+                nodes[v][d] += amp * (rnd() - 0.5);
+            }
+        }
+        if k % 7 == 6 {
+            let t = (rnd() * tris.len() as f64) as usize % tris.len();
+            tris[t].swap(0, 1);
+        }
+        let opts = CurveOptions::default();
+        let r = std::panic::catch_unwind(|| {
+            curve_linear_report(nodes, tris, vec![], &opts).map(|(s, _)| s.min_normal_cosine())
+        });
+        match r {
+            Ok(Ok(c)) => {
+                assert!(c >= opts.min_normal_cosine, "case {k}: {c}");
+                ok += 1;
+            }
+            Ok(Err(_)) => err += 1,
+            Err(_) => panic!("case {k}: curving panicked"),
+        }
+    }
+    eprintln!("mangled: {ok} accepted, {err} rejected");
+    assert!(ok > 0 && err > 0);
+}
+
+/// Options are validated; a surface curved through `Surface::from_linear` is the default
+/// one with that feature angle.
+#[test]
+fn options_and_from_linear() {
+    let raw = read_lin("tube");
+    for bad in [-1.0, 181.0, f64::NAN] {
+        let e = Surface::from_linear(raw.nodes.clone(), raw.tri3.clone(), vec![], bad);
+        assert!(
+            matches!(e, Err(curvetet::Error::InvalidArgument(_))),
+            "{bad}"
+        );
+    }
+    let a = Surface::from_linear(raw.nodes.clone(), raw.tri3.clone(), vec![7; 2292], 40.0).unwrap();
+    let (_, b, _) = curve("tube", &CurveOptions::default());
+    assert_eq!(a.nodes(), b.nodes());
+    assert!(a.tags().iter().all(|&t| t == 7));
+    // With features off (180 degrees) the rims are no longer followed as curves: the flat
+    // ends' edges still stay flat, but the sharp rims are smoothed over.
+    let c = Surface::from_linear(raw.nodes, raw.tri3, vec![], 180.0).unwrap();
+    assert_ne!(c.nodes(), a.nodes());
+}

@@ -193,7 +193,7 @@ mod tests {
         let m = read(&b, "t.stl").unwrap();
         assert_eq!(m.nodes.len(), 4);
         assert_eq!(m.tri3.len(), 4);
-        assert_eq!(m.tri3[3], [1, 2, 3]);
+        assert_eq!(m.tri3[3], [2, 1, 3]);
     }
 
     #[test]
