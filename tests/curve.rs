@@ -288,3 +288,70 @@ fn options_and_from_linear() {
     let c = Surface::from_linear(raw.nodes, raw.tri3, vec![], 180.0).unwrap();
     assert_ne!(c.nodes(), a.nodes());
 }
+
+/// Two coarse spheres whose flat faces face each other across a tiny gap: the linear
+/// surface is clean, but curving bulges both faces across the gap. The surface check finds
+/// the intersection, the guard straightens the edges involved, and the result is valid.
+#[test]
+fn curving_that_would_intersect_is_straightened() {
+    // Linear icosphere (level 1, 80 triangles), corners only.
+    let (p2nodes, p2tris) = common::icosphere(1);
+    let mut remap = vec![u32::MAX; p2nodes.len()];
+    let mut nodes: Vec<[f64; 3]> = Vec::new();
+    let mut tris: Vec<[u32; 3]> = Vec::new();
+    for t in &p2tris {
+        tris.push([0, 1, 2].map(|k| {
+            let v = t[k] as usize;
+            if remap[v] == u32::MAX {
+                remap[v] = nodes.len() as u32;
+                nodes.push(p2nodes[v]);
+            }
+            remap[v]
+        }));
+    }
+    // Rotate so that triangle 0's normal is +x (Rodrigues), then its plane is x = c.
+    let [a, b, c] = tris[0].map(|v| nodes[v as usize]);
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let w = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * w[2] - u[2] * w[1],
+        u[2] * w[0] - u[0] * w[2],
+        u[0] * w[1] - u[1] * w[0],
+    ];
+    let ln = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    let n = n.map(|x| x / ln);
+    // Axis k = n x e_x, angle between n and e_x.
+    let k = [0.0, n[2], -n[1]];
+    let s = (k[1] * k[1] + k[2] * k[2]).sqrt();
+    let cth = n[0];
+    let k = k.map(|x| x / s);
+    let rot = |p: [f64; 3]| {
+        let kxp = [
+            k[1] * p[2] - k[2] * p[1],
+            k[2] * p[0] - k[0] * p[2],
+            k[0] * p[1] - k[1] * p[0],
+        ];
+        let kdp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
+        [0, 1, 2].map(|d| p[d] * cth + kxp[d] * s + k[d] * kdp * (1.0 - cth))
+    };
+    for p in &mut nodes {
+        *p = rot(*p);
+    }
+    let plane = nodes[tris[0][0] as usize][0];
+    assert!(tris[0]
+        .iter()
+        .all(|&v| (nodes[v as usize][0] - plane).abs() < 1e-12));
+    // The second sphere: turned by 180 degrees about z, its facing plane 1e-3 beyond.
+    let shift = 2.0 * plane + 1e-3;
+    let nv = nodes.len() as u32;
+    let second: Vec<[f64; 3]> = nodes.iter().map(|p| [shift - p[0], -p[1], p[2]]).collect();
+    nodes.extend(second);
+    let more: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|v| v + nv)).collect();
+    tris.extend(more);
+    let (s, r) = curve_linear_report(nodes, tris, vec![], &CurveOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    eprintln!("two spheres: {r:?}");
+    assert!(r.straightened.intersection > 0, "{r:?}");
+    assert!(r.curved_edges > 0);
+    assert_eq!(s.shell_count(), 2);
+}

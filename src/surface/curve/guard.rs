@@ -14,8 +14,10 @@
 //! sub-triangle is straightened. The chord triangles were checked before curving, so with
 //! every edge straight nothing can conflict but rounding of the chord midpoints.
 //!
-//! Both guards repeat until neither changes anything; each round straightens at least one
-//! curved edge, so this ends.
+//! The intersection scan costs as much as the surface check's own, so it runs only when
+//! that check (`Surface::new`) reports an intersection; then both guards repeat until the
+//! check passes or neither guard changes anything (each round straightens at least one
+//! curved edge, so this ends).
 
 use rayon::prelude::*;
 
@@ -79,8 +81,8 @@ fn bad_fold(nodes: &[P3], tri: &[u32; 6], min_cos: f64) -> bool {
     }
 }
 
-/// Fold guard over triangles `todo` (all when `None`); returns edges straightened.
-fn fold_guard(s: &mut Edges, min_cos: f64) -> usize {
+/// The fold guard over all triangles; returns how many edges it straightened.
+pub(crate) fn fold_guard(s: &mut Edges, min_cos: f64) -> usize {
     let mut count = 0;
     let mut todo: Vec<u32> = (0..s.tris.len() as u32).collect();
     while !todo.is_empty() {
@@ -180,24 +182,18 @@ fn conflicting_mid_nodes(nodes: &[P3], tris: &[[u32; 6]], n_input: usize) -> Vec
     out
 }
 
-/// Runs both guards until the surface is clean (module docs).
-pub(crate) fn enforce(s: &mut Edges, min_cos: f64) -> GuardCounts {
-    let mut counts = GuardCounts::default();
-    loop {
-        counts.fold += fold_guard(s, min_cos);
-        let conflicting = conflicting_mid_nodes(s.nodes, s.tris, s.n_input);
-        let mut changed = 0;
-        for m in conflicting {
-            if let Some(e) = s.edge_of(m) {
-                if s.is_curved(e) {
-                    s.straighten(e);
-                    changed += 1;
-                }
+/// The intersection guard's pass: straightens every curved edge whose mid node is in a
+/// conflicting (or degenerate) sub-triangle; returns how many.
+pub(crate) fn intersection_pass(s: &mut Edges) -> usize {
+    let conflicting = conflicting_mid_nodes(s.nodes, s.tris, s.n_input);
+    let mut changed = 0;
+    for m in conflicting {
+        if let Some(e) = s.edge_of(m) {
+            if s.is_curved(e) {
+                s.straighten(e);
+                changed += 1;
             }
         }
-        counts.intersection += changed;
-        if changed == 0 {
-            return counts;
-        }
     }
+    changed
 }

@@ -27,7 +27,8 @@
 //!    [`CurveOptions::min_normal_cosine`] (fold check on the order-6 lattice) and no
 //!    sub-triangles may intersect; offending edges go back to straight, edge by edge,
 //!    until clean.
-//! 5. [`Surface::new`] checks the result, as for any P2 input.
+//! 5. [`Surface::new`] checks the result, as for any P2 input (an intersection it finds
+//!    sends the surface back to the guards).
 //!
 //! Input vertices keep their index and their bit-exact coordinates; mid nodes follow them,
 //! one per edge in sorted (smaller vertex, larger vertex) order.
@@ -47,7 +48,7 @@ mod tangents;
 
 pub use guard::GuardCounts;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::vec3::{dot, normalize, scale, sub};
 use crate::geom::P3;
 use crate::surface::Surface;
@@ -281,20 +282,38 @@ pub fn curve_linear_report(
         nodes[n_input + e] = m;
     }
 
-    let mut state = guard::Edges {
-        nodes: &mut nodes,
-        tris: &tris,
-        ends: edges.iter().map(|e| (e.nodes, e.tris)).collect(),
-        n_input,
+    let ends: Vec<([u32; 2], [u32; 2])> = edges.iter().map(|e| (e.nodes, e.tris)).collect();
+    let surface = loop {
+        let mut state = guard::Edges {
+            nodes: &mut nodes,
+            tris: &tris,
+            ends: ends.clone(),
+            n_input,
+        };
+        report.straightened.fold += guard::fold_guard(&mut state, opts.min_normal_cosine);
+        match Surface::new(state.nodes.to_vec(), tris.clone(), tags.clone()) {
+            Ok(s) => break s,
+            Err(e)
+                if matches!(
+                    e.surface_defect(),
+                    Some(SurfaceDefect::SelfIntersection | SurfaceDefect::FoldedTriangle)
+                ) =>
+            {
+                let n = guard::intersection_pass(&mut state);
+                if n == 0 {
+                    return Err(e);
+                }
+                report.straightened.intersection += n;
+            }
+            Err(e) => return Err(e),
+        }
     };
-    report.straightened = guard::enforce(&mut state, opts.min_normal_cosine);
     report.curved_edges = (0..edges.len())
         .filter(|&e| {
             let [a, b] = edges[e].nodes;
             nodes[n_input + e] != crate::geom::vec3::mid(nodes[a as usize], nodes[b as usize])
         })
         .count();
-    let surface = Surface::new(nodes, tris, tags)?;
     Ok((surface, report))
 }
 
