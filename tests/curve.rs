@@ -242,8 +242,8 @@ fn mangled_surfaces_never_panic() {
         let amp = [1e-9, 1e-3, 0.5, 5.0][k % 4];
         for _ in 0..1 + k % 5 {
             let v = (rnd() * nodes.len() as f64) as usize % nodes.len();
-            for d in 0..3 {
-                nodes[v][d] += amp * (rnd() - 0.5);
+            for x in nodes[v].iter_mut() {
+                *x += amp * (rnd() - 0.5);
             }
         }
         if k % 7 == 6 {
@@ -354,4 +354,65 @@ fn curving_that_would_intersect_is_straightened() {
     assert!(r.straightened.intersection > 0, "{r:?}");
     assert!(r.curved_edges > 0);
     assert_eq!(s.shell_count(), 2);
+}
+
+/// The command-line tool: `curve` writes a P2 surface that reads back unchanged, `check`
+/// reports a linear surface's defect with exit code 4, and a read-only output format is
+/// refused before any work (exit code 1).
+#[test]
+fn command_line_curve_and_check() {
+    let exe = env!("CARGO_BIN_EXE_curvetet");
+    let dir = std::env::temp_dir().join(format!("curvetet-curve-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("sphere_p2.msh");
+    let input = data_dir().join("sphere_lin.off");
+    let st = std::process::Command::new(exe)
+        .args([
+            "curve",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .args(["--feature-angle", "40"])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let back = io::read_surface(&out).unwrap();
+    let (_, s, _) = curve("sphere", &CurveOptions::default());
+    assert_eq!(back.nodes(), s.nodes());
+    assert_eq!(back.triangles(), s.triangles());
+
+    let bad = data_dir().join("bad/open_lin.off");
+    let st = std::process::Command::new(exe)
+        .args(["check", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(4));
+    assert!(String::from_utf8_lossy(&st.stderr).contains("not-closed"));
+
+    let st = std::process::Command::new(exe)
+        .args(["mesh", input.to_str().unwrap(), "-o"])
+        .arg(dir.join("x.stl"))
+        .output()
+        .unwrap();
+    assert_eq!(st.status.code(), Some(1));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `io::read_any_surface` curves linear files and passes P2 files through.
+#[test]
+fn read_any_surface_curves_only_linear_input() {
+    let opts = CurveOptions::default();
+    let lin = io::read_any_surface(&data_dir().join("tube_lin.off"), &opts).unwrap();
+    let (_, s, _) = curve("tube", &opts);
+    assert_eq!(lin.nodes(), s.nodes());
+    let p2 = io::read_any_surface(&data_dir().join("sphere_p2.msh"), &opts).unwrap();
+    let strict = io::read_surface(&data_dir().join("sphere_p2.msh")).unwrap();
+    assert_eq!(p2.nodes(), strict.nodes());
+    let e = io::read_surface(&data_dir().join("tube_lin.off")).unwrap_err();
+    assert_eq!(e.surface_defect().map(|k| k.name()), Some("linear-surface"));
 }

@@ -342,12 +342,27 @@ fn curve_summary(name: &str, s: &Surface, r: &CurveReport) -> String {
     )
 }
 
+/// Fails early, before any work, when `output` is not a format curvetet writes.
+fn check_output(output: &Path) -> Result<(), Error> {
+    let f = io::Format::from_path(output)?;
+    if !f.is_writable() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: .{} is read only; write .msh, .vtu, .vtk or .mesh",
+            output.display(),
+            f.extension()
+        )));
+    }
+    Ok(())
+}
+
 fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
+    check_output(&a.output)?;
     let surface = read_surface_any(&a.input, &a.curve)?;
     run_mesh(&surface, &a.mesh, &a.output)
 }
 
 fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
+    check_output(output)?;
     let raw = io::read(input)?;
     let name = input.display().to_string();
     if !raw.tri6.is_empty() {

@@ -37,12 +37,13 @@ pub struct GuardCounts {
     pub intersection: usize,
 }
 
-/// The mutable state: node positions and, per edge, whether it is curved.
+/// What the guards work on: the node positions (mid nodes are moved) and the edges. An
+/// edge is curved when its mid node is not at its chord midpoint.
 pub(crate) struct Edges<'a> {
     pub nodes: &'a mut [P3],
     pub tris: &'a [[u32; 6]],
     /// Per edge: its two corner nodes and its two triangles.
-    pub ends: Vec<([u32; 2], [u32; 2])>,
+    pub ends: &'a [([u32; 2], [u32; 2])],
     /// Number of input vertices: edge e has mid node `n_input + e`.
     pub n_input: usize,
 }

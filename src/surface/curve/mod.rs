@@ -5,7 +5,7 @@
 //! [`Surface::from_linear`]) turns one into a checked P2 [`Surface`] for the mesher:
 //!
 //! 1. **Checks** of the linear surface (`check`): the P2 surface's checks applied to the
-//!    corner triangles, with the same [`SurfaceDefect`](crate::SurfaceDefect) kinds —
+//!    corner triangles, with the same [`SurfaceDefect`] kinds —
 //!    empty, indices, zero-area facets (by index), coordinates, unused and duplicate
 //!    vertices, open / non-manifold edges and vertices, inconsistent orientation, exact
 //!    self-intersection.
@@ -287,7 +287,7 @@ pub fn curve_linear_report(
         let mut state = guard::Edges {
             nodes: &mut nodes,
             tris: &tris,
-            ends: ends.clone(),
+            ends: &ends,
             n_input,
         };
         report.straightened.fold += guard::fold_guard(&mut state, opts.min_normal_cosine);
