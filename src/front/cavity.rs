@@ -116,7 +116,7 @@ impl Search<'_> {
             if buf.is_empty() {
                 return false;
             }
-            if best.as_ref().is_none_or(|b| buf.len() < b.1.len()) {
+            if best.as_ref().map_or(true, |b| buf.len() < b.1.len()) {
                 best = Some((fi, buf.clone()));
                 if buf.len() == 1 {
                     break;
@@ -239,7 +239,7 @@ impl Mesher<'_> {
             };
             let me = &*self;
             let curved_ok = |t: [u32; 4], tp: &[P3; 4]| {
-                me.p2_nodes(t, tp).is_none_or(|x| super::curved_valid(&x))
+                me.p2_nodes(t, tp).map_or(true, |x| super::curved_valid(&x))
             };
             let mut vs = verts.clone();
             if steiner.is_some() {
@@ -288,7 +288,7 @@ impl Mesher<'_> {
             let n = normalize(tri_normal(p[0], p[1], p[2]));
             // n . (q - p0) >= t   (inward normals)
             pr.add_constraint(
-                &[(x, n[0]), (y, n[1]), (z, n[2]), (t, -1.0)],
+                [(x, n[0]), (y, n[1]), (z, n[2]), (t, -1.0)],
                 ComparisonOp::Ge,
                 dot(n, p[0]),
             );

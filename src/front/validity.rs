@@ -50,14 +50,17 @@ pub struct FaceRef {
     pub boundary: bool,
 }
 
-/// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
-/// front, t[3] the apex) against the front faces `near` (excluding the base face).
-/// Returns `None` on any conflict.
-thread_local! { pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
+thread_local! {
+/// Debug: why the last check failed.
+pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
 fn why(s: String) {
     WHY.with(|w| *w.borrow_mut() = s);
 }
 
+/// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
+/// front, t[3] the apex) against the front faces `near` (excluding the base face).
+/// Returns `None` on any conflict. `min_dist` > 0 also rejects a new point (apex id
+/// [`NEW_POINT`]) that would come closer than that to an unrelated front face.
 pub fn check(
     t: [u32; 4],
     tp: [P3; 4],
@@ -230,11 +233,11 @@ fn wedge_gap_deg(tp: [P3; 4], e0: usize, e1: usize, f_other: P3, nf: P3) -> (f64
     let e2v = normalize(sub(nf, scale(t, dot(nf, t))));
     let mut best = 360.0f64;
     let mut best_k = 0;
-    for k in 0..4 {
+    for (k, &q) in tp.iter().enumerate() {
         if k == e0 || k == e1 {
             continue;
         }
-        let x = perp(tp[k]);
+        let x = perp(q);
         let mut ang = dot(x, e2v).atan2(dot(x, e1v)).to_degrees();
         if ang < 0.0 {
             ang += 360.0;
