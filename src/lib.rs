@@ -6,6 +6,7 @@
 //! nodes, and the result is certified (Bernstein bounds of the Jacobian) before it is
 //! returned as a [`TetMesh`].
 
+pub mod capi;
 pub mod error;
 pub mod front;
 pub mod generate;

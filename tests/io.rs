@@ -219,6 +219,9 @@ fn tet_tag_of(format: Format) -> i32 {
     match format {
         Format::Msh | Format::Medit => VOLUME_TAG,
         Format::Vtu | Format::Vtk => 0,
+        Format::Stl | Format::Off | Format::Obj | Format::Ply => {
+            unreachable!("{format:?} holds no tetrahedra")
+        }
     }
 }
 

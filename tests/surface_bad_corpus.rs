@@ -1,11 +1,27 @@
-//! The bad-input corpus (tests/data/bad, made by make_bad.py): every file is rejected by
-//! `Surface::new` with the defect kind EXPECTED.txt names, and the message names an
-//! element (triangle, edge or node) or says why the whole model is rejected.
+//! The bad-input corpus (tests/data/bad, made by make_bad.py and make_bad_linear.py):
+//! every file is rejected with the defect kind EXPECTED.txt names, and the message names
+//! an element (triangle, edge or node) or says why the whole model is rejected. P2 files
+//! (.msh) go to `Surface::new`; linear files (.off, .stl) go through the real readers to
+//! `Surface::from_linear`, and must give the same kinds as their P2 counterparts.
 
 mod common;
 
 use common::{data_dir, read_msh41};
-use curvetet::{Error, Surface};
+use curvetet::{io, Error, Result, Surface};
+
+/// The surface a corpus file makes: P2 files through `Surface::new`, linear ones through
+/// the product's reader and `Surface::from_linear`.
+fn corpus_surface(path: &std::path::Path) -> Result<Surface> {
+    let name = path.file_name().unwrap().to_str().unwrap();
+    if name.ends_with(".msh") {
+        let m = read_msh41(path);
+        Surface::new(m.nodes, m.tris, m.tags)
+    } else {
+        let raw = io::read(path).unwrap_or_else(|e| panic!("{name}: the reader failed: {e}"));
+        assert!(raw.tri6.is_empty(), "{name}: not a linear file");
+        Surface::from_linear(raw.nodes, raw.tri3, raw.tri3_tags, 40.0)
+    }
+}
 
 #[test]
 fn every_bad_file_gives_its_expected_kind() {
@@ -15,8 +31,7 @@ fn every_bad_file_gives_its_expected_kind() {
     let mut kinds = std::collections::BTreeSet::new();
     for line in expected.lines().filter(|l| !l.trim().is_empty()) {
         let (file, kind) = line.split_once(' ').expect("`filename kind-name`");
-        let m = read_msh41(&dir.join(file));
-        match Surface::new(m.nodes, m.tris, m.tags) {
+        match corpus_surface(&dir.join(file)) {
             Err(Error::InvalidSurface { kind: k, msg }) => {
                 assert_eq!(k.name(), kind, "{file}: {msg}");
                 let names_something = [
@@ -37,8 +52,28 @@ fn every_bad_file_gives_its_expected_kind() {
         kinds.insert(kind.to_string());
         n += 1;
     }
-    assert!(n >= 15, "only {n} corpus files");
+    assert!(n >= 25, "only {n} corpus files");
     assert!(kinds.len() >= 14, "only {} kinds covered", kinds.len());
+    let linear = expected.lines().filter(|l| l.contains("_lin.")).count();
+    assert!(linear >= 10, "only {linear} linear corpus files");
+}
+
+/// A zero-area facet is reported with its index (triangle 4 of degenerate_lin.off,
+/// triangle 2 of degenerate_facet_lin.stl, whose corners weld to a repeated vertex).
+#[test]
+fn linear_zero_area_facets_are_named_by_index() {
+    let dir = data_dir().join("bad");
+    for (file, t) in [
+        ("degenerate_lin.off", "triangle 4 (corners 1, 0, 4)"),
+        ("degenerate_facet_lin.stl", "triangle 2 "),
+    ] {
+        let e = corpus_surface(&dir.join(file)).unwrap_err();
+        assert_eq!(
+            e.surface_defect().map(|k| k.name()),
+            Some("degenerate-triangle")
+        );
+        assert!(e.to_string().contains(t), "{file}: {e}");
+    }
 }
 
 #[test]
@@ -47,7 +82,7 @@ fn every_corpus_file_is_listed() {
     let expected = std::fs::read_to_string(dir.join("EXPECTED.txt")).unwrap();
     for entry in std::fs::read_dir(&dir).unwrap() {
         let name = entry.unwrap().file_name().into_string().unwrap();
-        if name.ends_with(".msh") {
+        if name.ends_with(".msh") || name.ends_with(".off") || name.ends_with(".stl") {
             assert!(
                 expected
                     .lines()

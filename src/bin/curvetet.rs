@@ -6,6 +6,7 @@ use curvetet::geom::quadrature::{enclosed_volume, enclosed_volume_linear};
 use curvetet::io::{self, MshVersion, WriteOptions};
 use curvetet::mesh::quality::QualityReport;
 use curvetet::mesh::{check, TetMesh};
+use curvetet::surface::curve::{curve_linear_report, CurveOptions, CurveReport};
 use curvetet::{Error, Generated, Options, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -25,9 +26,23 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Mesh a closed P2 surface (.msh, .vtu, .vtk, .mesh) into a P2 tet mesh.
+    /// Mesh a closed surface into a P2 tet mesh: a P2 surface (.msh, .vtu, .vtk, .mesh), or
+    /// a linear one (.stl, .off, .obj, .ply, or 3-node triangles), which is curved first.
     Mesh(MeshArgs),
-    /// Check a surface or a volume mesh and print its report.
+    /// Curve a closed linear triangle surface (.stl, .off, .obj, .ply, ...) into a P2
+    /// surface and write it (.msh, .vtu, .vtk, .mesh).
+    Curve {
+        /// Input linear surface.
+        input: PathBuf,
+        /// Output P2 surface.
+        #[arg(short, long)]
+        output: PathBuf,
+        #[command(flatten)]
+        curve: CurveArgs,
+        #[command(flatten)]
+        write: WriteArgs,
+    },
+    /// Check a surface (P2 or linear) or a volume mesh and print its report.
     Check {
         /// The file to check.
         file: PathBuf,
@@ -37,6 +52,8 @@ enum Cmd {
         /// Draw the scaled-Jacobian and skewness histograms of a volume mesh as SVG here.
         #[arg(long)]
         plot: Option<PathBuf>,
+        #[command(flatten)]
+        curve: CurveArgs,
     },
     /// Convert a mesh between formats (by extension: .msh .vtu .vtk .mesh).
     Convert {
@@ -74,7 +91,23 @@ struct MeshArgs {
     #[arg(short, long)]
     output: PathBuf,
     #[command(flatten)]
+    curve: CurveArgs,
+    #[command(flatten)]
     mesh: MeshOptions,
+}
+
+#[derive(Args)]
+struct CurveArgs {
+    /// For a linear input surface: edges whose triangles' normals differ by more than this
+    /// angle (degrees) are sharp features, kept sharp and followed by the curving.
+    #[arg(long, default_value_t = 40.0)]
+    feature_angle: f64,
+}
+
+impl CurveArgs {
+    fn options(&self) -> CurveOptions {
+        CurveOptions::with_feature_angle(self.feature_angle)
+    }
 }
 
 #[derive(Args)]
@@ -154,7 +187,18 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let r = match cli.cmd {
         Cmd::Mesh(a) => cmd_mesh(&a),
-        Cmd::Check { file, json, plot } => cmd_check(&file, json, plot.as_deref()),
+        Cmd::Curve {
+            input,
+            output,
+            curve,
+            write,
+        } => cmd_curve(&input, &output, &curve, &write),
+        Cmd::Check {
+            file,
+            json,
+            plot,
+            curve,
+        } => cmd_check(&file, json, plot.as_deref(), &curve),
         Cmd::Convert {
             input,
             output,
@@ -272,9 +316,84 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
     Ok(())
 }
 
+/// The surface in `path`: P2 as it is, linear curved (with a summary on stderr).
+fn read_surface_any(path: &Path, c: &CurveArgs) -> Result<Surface, Error> {
+    let raw = io::read(path)?;
+    let name = path.display().to_string();
+    if !raw.tri6.is_empty() || raw.tri3.is_empty() {
+        return io::surface_from_raw(raw, &name);
+    }
+    let (s, r) = curve_raw(raw, &name, c)?;
+    eprintln!("{}", curve_summary(&name, &s, &r));
+    Ok(s)
+}
+
+/// Curves a linear surface read from a file.
+fn curve_raw(raw: io::RawMesh, name: &str, c: &CurveArgs) -> Result<(Surface, CurveReport), Error> {
+    if !raw.tet4.is_empty() || !raw.tet10.is_empty() {
+        // Let the library say why (a linear volume mesh is not a surface).
+        return io::surface_from_raw_any(raw, name, &c.options())
+            .map(|s| (s, CurveReport::default()));
+    }
+    curve_linear_report(raw.nodes, raw.tri3, raw.tri3_tags, &c.options())
+}
+
+fn curve_summary(name: &str, s: &Surface, r: &CurveReport) -> String {
+    let corners = s.corner_nodes().len();
+    format!(
+        "{name}: linear surface, {corners} vertices, {} triangles: curved {} of {} edges \
+         ({} feature edges, {} kept flat, {} straightened to avoid folds, {} to avoid \
+         intersections); volume {:.9} (linear {:.9}), min cos(curved normal, chord normal) {:.4}",
+        s.triangles().len(),
+        r.curved_edges,
+        r.edges,
+        r.feature_edges,
+        r.flat_edges,
+        r.straightened.fold,
+        r.straightened.intersection,
+        s.volume(),
+        s.chord_volume(),
+        s.min_normal_cosine()
+    )
+}
+
+/// Fails early, before any work, when `output` is not a format curvetet writes.
+fn check_output(output: &Path) -> Result<(), Error> {
+    let f = io::Format::from_path(output)?;
+    if !f.is_writable() {
+        return Err(Error::InvalidArgument(format!(
+            "{}: .{} is read only; write .msh, .vtu, .vtk or .mesh",
+            output.display(),
+            f.extension()
+        )));
+    }
+    Ok(())
+}
+
 fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
-    let surface = io::read_surface(&a.input)?;
+    check_output(&a.output)?;
+    let surface = read_surface_any(&a.input, &a.curve)?;
     run_mesh(&surface, &a.mesh, &a.output)
+}
+
+fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
+    check_output(output)?;
+    let raw = io::read(input)?;
+    let name = input.display().to_string();
+    if !raw.tri6.is_empty() {
+        return Err(Error::InvalidArgument(format!(
+            "{name}: already a P2 surface ({} 6-node triangles); nothing to curve",
+            raw.tri6.len()
+        )));
+    }
+    let (s, r) = curve_raw(raw, &name, c)?;
+    for w in s.warnings() {
+        eprintln!("warning: {w}");
+    }
+    eprintln!("{}", curve_summary(&name, &s, &r));
+    io::write_surface(output, s.nodes(), s.triangles(), s.tags(), &w.options())?;
+    eprintln!("wrote {}", output.display());
+    Ok(())
 }
 
 fn cmd_demo(
@@ -340,9 +459,54 @@ fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Er
     Ok(())
 }
 
-fn cmd_check(path: &Path, json: bool, plot: Option<&Path>) -> Result<(), Error> {
+fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Result<(), Error> {
     let raw = io::read(path)?;
     let name = path.display().to_string();
+    let linear = raw.tri6.is_empty() && !raw.tri3.is_empty();
+    if linear && raw.tet10.is_empty() && raw.tet4.is_empty() {
+        let (s, r) = curve_raw(raw, &name, c)?;
+        for w in s.warnings() {
+            eprintln!("warning: {w}");
+        }
+        if json {
+            let j = serde_json::json!({
+                "kind": "linear-surface", "file": name, "valid": true,
+                "vertices": s.corner_nodes().len(), "triangles": s.triangles().len(),
+                "shells": s.shell_count(), "enclosed_volume_linear": s.chord_volume(),
+                "curved": {
+                    "edges": r.edges, "feature_edges": r.feature_edges,
+                    "curved_edges": r.curved_edges, "flat_edges": r.flat_edges,
+                    "straightened_fold": r.straightened.fold,
+                    "straightened_intersection": r.straightened.intersection,
+                    "enclosed_volume": s.volume(), "min_normal_cosine": s.min_normal_cosine(),
+                },
+                "warnings": s.warnings(),
+            });
+            println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+        } else {
+            println!("{name}: valid closed linear surface");
+            println!(
+                "  vertices {}, triangles {}, shells {}, enclosed volume {:.12}",
+                s.corner_nodes().len(),
+                s.triangles().len(),
+                s.shell_count(),
+                s.chord_volume()
+            );
+            println!(
+                "  curves to a valid P2 surface (feature angle {} deg): {} of {} edges curved, \
+                 {} feature edges, {} straightened by the guards; volume {:.12}, min \
+                 cos(curved normal, chord normal) {:.4}",
+                c.feature_angle,
+                r.curved_edges,
+                r.edges,
+                r.feature_edges,
+                r.straightened.fold + r.straightened.intersection,
+                s.volume(),
+                s.min_normal_cosine()
+            );
+        }
+        return Ok(());
+    }
     if raw.tet10.is_empty() && raw.tet4.is_empty() {
         let s = io::surface_from_raw(raw, &name)?;
         for w in s.warnings() {

@@ -9,6 +9,7 @@
 //! curved boundary, the certified Jacobian test. New faces that coincide with front
 //! faces close them.
 
+mod cavity;
 mod grid;
 mod repair;
 pub mod size;
@@ -51,6 +52,8 @@ pub struct FrontStats {
     pub repairs: u64,
     /// Tets deleted by repairs.
     pub deleted: u64,
+    /// Stuck cavities closed by the exact search.
+    pub cavities: u64,
 }
 
 #[derive(Clone, Copy)]
@@ -60,7 +63,16 @@ struct Face {
     tries: u8,
     /// Index of the input triangle when this face is a boundary face, else u32::MAX.
     btri: u32,
+    /// Version: queue entries with an older version are stale.
+    ver: u32,
 }
+
+/// A queue entry: (tries, class, key, face, version); smallest first.
+type QEntry = Reverse<(u8, u8, Key, u32, u32)>;
+
+/// Wedges (unmeshed dihedral angle between neighbouring front faces) below this are
+/// closed first: left for later they become the pockets an advancing front gets stuck in.
+const WEDGE_FIRST_DEG: f64 = 75.0;
 
 /// Ordered f64 for the queue.
 #[derive(Clone, Copy, PartialEq, PartialOrd)]
@@ -83,6 +95,13 @@ struct Cand {
 }
 
 const NEW: u32 = u32::MAX;
+thread_local! { pub static WHYSTAT: std::cell::RefCell<std::collections::BTreeMap<String, u64>> = const { std::cell::RefCell::new(std::collections::BTreeMap::new()) }; }
+thread_local! { pub static NEARSTAT: std::cell::RefCell<[[u64;3];3]> = const { std::cell::RefCell::new([[0;3];3]) }; }
+thread_local! { static LEVEL: std::cell::RefCell<u8> = const { std::cell::RefCell::new(0) }; }
+/// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
+/// thinner one could only be closed by a flat tet with a curved face, which is invalid
+/// on concave boundaries, and boundary faces can never be remeshed.
+const MIN_BOUNDARY_GAP_DEG: f64 = 5.0;
 thread_local! { pub static FAILS: std::cell::RefCell<[[u64;4];3]> = const { std::cell::RefCell::new([[0;4];3]) }; }
 
 #[inline]
@@ -107,7 +126,9 @@ pub(crate) struct Mesher<'a> {
     face_map: HashMap<[u32; 3], u32>,
     btri_map: HashMap<[u32; 3], u32>,
     bedge_mid: HashMap<(u32, u32), u32>,
-    heap: BinaryHeap<Reverse<(u8, Key, u32)>>,
+    heap: BinaryHeap<QEntry>,
+    /// Directed edge (a, b) of a live front face -> that face.
+    edges: HashMap<(u32, u32), u32>,
     grid: FaceGrid,
     vtree: MutableKdTree<f64, 3>,
     tets: Vec<[u32; 4]>,
@@ -159,6 +180,7 @@ impl<'a> Mesher<'a> {
             btri_map: HashMap::with_capacity(surf_tris.len()),
             bedge_mid,
             heap: BinaryHeap::new(),
+            edges: HashMap::with_capacity(surf_tris.len() * 6),
             grid: FaceGrid::new(lo, cell),
             vtree: MutableKdTree::default(),
             tets: Vec::new(),
@@ -180,7 +202,22 @@ impl<'a> Mesher<'a> {
         m
     }
 
+    fn trace(&self, what: &str, v: [u32; 3]) {
+        if let Ok(t) = std::env::var("CURVETET_TRACE") {
+            let set: Vec<u32> = t.split(',').filter_map(|x| x.parse().ok()).collect();
+            if v.iter().all(|x| set.contains(x)) {
+                eprintln!(
+                    "TRACE {what} {:?} step {} tets {}",
+                    v,
+                    self.stats.steps,
+                    self.tets.len()
+                );
+            }
+        }
+    }
+
     fn add_face(&mut self, v: [u32; 3]) {
+        self.trace("add", v);
         let id = self.faces.len() as u32;
         let k = key3(v);
         let btri = if v.iter().all(|&x| (x as usize) < self.n_surf) {
@@ -193,7 +230,11 @@ impl<'a> Mesher<'a> {
             alive: true,
             tries: 0,
             btri,
+            ver: 0,
         });
+        for k in 0..3 {
+            self.edges.insert((v[k], v[(k + 1) % 3]), id);
+        }
         self.face_map.insert(k, id);
         let p = [
             self.pts[v[0] as usize],
@@ -209,8 +250,53 @@ impl<'a> Mesher<'a> {
                 let _ = self.vtree.add(&self.pts[xi], x);
             }
         }
-        let key = face_size(&p);
-        self.heap.push(Reverse((0, Key(key), id)));
+        self.enqueue(id);
+        // The neighbours' wedges changed.
+        for k in 0..3 {
+            if let Some(&g) = self.edges.get(&(v[(k + 1) % 3], v[k])) {
+                self.faces[g as usize].ver += 1;
+                self.enqueue(g);
+            }
+        }
+    }
+
+    /// Unmeshed dihedral angle (degrees) at the edge shared by live faces `f` and `g`.
+    fn wedge_deg(&self, f: u32, g: u32) -> f64 {
+        let fv = self.faces[f as usize].v;
+        let gv = self.faces[g as usize].v;
+        let fp = fv.map(|x| self.pts[x as usize]);
+        let gp = gv.map(|x| self.pts[x as usize]);
+        let n1 = normalize(tri_normal(fp[0], fp[1], fp[2]));
+        let n2 = normalize(tri_normal(gp[0], gp[1], gp[2]));
+        let theta = (-dot(n1, n2)).clamp(-1.0, 1.0).acos().to_degrees();
+        let Some(&d) = gv.iter().find(|x| !fv.contains(x)) else {
+            return 360.0;
+        };
+        if orient3d(fp[0], fp[1], fp[2], self.pts[d as usize]) > 0 {
+            theta
+        } else {
+            360.0 - theta
+        }
+    }
+
+    /// Queue live face `id` under its current version: faces in a thin wedge with a
+    /// neighbour first (thinnest first), then smallest first.
+    fn enqueue(&mut self, id: u32) {
+        let f = self.faces[id as usize];
+        let mut wedge = 360.0f64;
+        for k in 0..3 {
+            if let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) {
+                wedge = wedge.min(self.wedge_deg(id, g));
+            }
+        }
+        let p = self.face_pts(id);
+        let (class, key) = if wedge < WEDGE_FIRST_DEG {
+            (0, wedge)
+        } else {
+            (1, face_size(&p))
+        };
+        self.heap
+            .push(Reverse((f.tries, class, Key(key), id, f.ver)));
     }
 
     fn kill_face(&mut self, id: u32) {
@@ -220,6 +306,13 @@ impl<'a> Mesher<'a> {
         }
         f.alive = false;
         let v = f.v;
+        self.trace("kill", v);
+        for k in 0..3 {
+            let e = (v[k], v[(k + 1) % 3]);
+            if self.edges.get(&e) == Some(&id) {
+                self.edges.remove(&e);
+            }
+        }
         self.face_map.remove(&key3(v));
         for &x in &v {
             let xi = x as usize;
@@ -279,15 +372,20 @@ impl<'a> Mesher<'a> {
         let max_steps = 200 * self.surf_tris.len() as u64 + 1_000_000;
         let max_repairs = 50 + self.surf_tris.len() as u64;
         let mut last_report = 0.0;
-        while let Some(Reverse((tries, _, fid))) = self.heap.pop() {
+        while let Some(Reverse((tries, _, _, fid, ver))) = self.heap.pop() {
             let f = self.faces[fid as usize];
-            if !f.alive || f.tries != tries {
+            if !f.alive || f.tries != tries || f.ver != ver {
                 continue;
             }
             self.stats.steps += 1;
             if self.stats.steps % 20000 == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
                 let open = self.faces.iter().filter(|f| f.alive).count();
-                eprintln!("fails {:?}", FAILS.with(|f| *f.borrow()));
+                eprintln!("why {:?}", WHYSTAT.with(|m| m.borrow().clone()));
+                eprintln!(
+                    "fails {:?} near {:?}",
+                    FAILS.with(|f| *f.borrow()),
+                    NEARSTAT.with(|f| *f.borrow())
+                );
                 eprintln!(
                     "step {} tets {} pts {} open {} tries {} stats {:?} vol {:.4}",
                     self.stats.steps,
@@ -324,13 +422,20 @@ impl<'a> Mesher<'a> {
                 continue;
             }
             if tries < 3 {
-                self.faces[fid as usize].tries = tries + 1;
-                let p = self.face_pts(fid);
-                self.heap
-                    .push(Reverse((tries + 1, Key(face_size(&p)), fid)));
+                let f = &mut self.faces[fid as usize];
+                f.tries = tries + 1;
+                f.ver += 1;
+                self.enqueue(fid);
                 continue;
             }
-            // Stuck at every level: remesh around it.
+            // Stuck at every level: close its cavity exactly if it is small...
+            if let Some(comp) = self.component(fid, cavity::MAX_CAVITY_FACES) {
+                if self.fill_cavity(&comp) {
+                    self.stats.cavities += 1;
+                    continue;
+                }
+            }
+            // ...else remesh around it.
             if self.stats.repairs >= max_repairs {
                 return Err(self.stuck_error(fid, "repair limit reached"));
             }
@@ -387,10 +492,11 @@ impl<'a> Mesher<'a> {
                                 .filter(|&&k| k != i)
                                 .map(|&k| FaceRef {
                                     v: self.faces[k as usize].v,
+                                    boundary: self.faces[k as usize].btri != u32::MAX,
                                 })
                                 .collect();
                             let pts = &self.pts;
-                            let v = validity::check(t, tp, &near, |x: u32| pts[x as usize]);
+                            let v = validity::check(t, tp, &near, |x: u32| pts[x as usize], 0.0);
                             let w = validity::WHY.with(|w| w.borrow().clone());
                             let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
                             let o = orient3d(tp[0], tp[1], tp[2], tp[3]);
@@ -431,6 +537,7 @@ impl<'a> Mesher<'a> {
 
     /// Try to build a tet on front face `fid` at relaxation `level`. True on success.
     fn advance(&mut self, fid: u32, level: u8) -> bool {
+        LEVEL.with(|l| *l.borrow_mut() = level);
         let f = self.faces[fid as usize];
         let fp = self.face_pts(fid);
         let c = centroid3(fp[0], fp[1], fp[2]);
@@ -448,13 +555,16 @@ impl<'a> Mesher<'a> {
             normalize(flat_n)
         };
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let target = self.size.at(c).clamp(0.55 * lf, 1.8 * lf);
+        let l_field = self.size.at(c);
+        let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);
         let a = axpy(c, h, n);
         let (radius, min_new_dist) = match level {
-            0 => (self.opts.alpha * h, 0.45 * target),
-            1 => (2.0 * self.opts.alpha * h, 0.25 * target),
-            _ => (3.0 * self.opts.alpha * h, 0.0),
+            // New points keep away from existing ones by a fraction of the *field* size,
+            // so a pocket of small faces cannot breed ever smaller elements.
+            0 => (self.opts.alpha * h, 0.45 * l_field),
+            1 => (2.0 * self.opts.alpha * h, 0.35 * l_field),
+            _ => (3.0 * self.opts.alpha * h, 0.25 * l_field),
         };
         // Candidate existing vertices.
         let found = self
@@ -485,8 +595,8 @@ impl<'a> Mesher<'a> {
         // New points: the ideal one, and lower ones when relaxing.
         let heights: &[f64] = match level {
             0 => &[1.0],
-            1 => &[1.0, 0.6, 0.35],
-            _ => &[1.0, 0.6, 0.35, 0.2],
+            1 => &[1.0, 0.7],
+            _ => &[1.0, 0.7, 0.5],
         };
         for &s in heights {
             let p = axpy(c, s * h, n);
@@ -569,25 +679,64 @@ impl<'a> Mesher<'a> {
             if i != fid {
                 self.near.push(FaceRef {
                     v: self.faces[i as usize].v,
+                    boundary: self.faces[i as usize].btri != u32::MAX,
                 });
             }
         }
         self.near_ids = near_ids;
+        if self.near.len() > 400 && std::env::var_os("CURVETET_DEBUG4").is_some() {
+            eprintln!(
+                "big near {} bb {:?} cands {} h {} fp {:?}",
+                self.near.len(),
+                bb,
+                cands.len(),
+                h,
+                fp
+            );
+        }
+        NEARSTAT.with(|n| {
+            let mut n = n.borrow_mut();
+            n[level as usize][0] += 1;
+            n[level as usize][1] += self.near.len() as u64;
+            n[level as usize][2] += cands.len() as u64;
+        });
+        let prox = match level {
+            0 => 0.35 * target,
+            1 => 0.2 * target,
+            _ => 0.0,
+        };
         let mut chosen = None;
         if cands.is_empty() {
             FAILS.with(|f| f.borrow_mut()[level as usize][0] += 1);
         }
         for cd in &cands {
-            let apex = if cd.id == NEW { u32::MAX - 1 } else { cd.id };
+            let apex = if cd.id == NEW {
+                validity::NEW_POINT
+            } else {
+                cd.id
+            };
             let t = [f.v[0], f.v[1], f.v[2], apex];
             let tp = [fp[0], fp[1], fp[2], cd.p];
             let pts = &self.pts;
             let pos = |i: u32| pts[i as usize];
-            let Some(verdict) = validity::check(t, tp, &self.near, pos) else {
+            let Some(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
                 FAILS.with(|f| f.borrow_mut()[level as usize][1] += 1);
+                if level == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
+                    let w = validity::WHY.with(|w| w.borrow().clone());
+                    let cat: String = w
+                        .chars()
+                        .filter(|c| c.is_alphabetic() || *c == ' ')
+                        .collect::<String>()
+                        .split_whitespace()
+                        .collect::<Vec<_>>()
+                        .join(" ");
+                    let cat = format!("{}{}", if cd.id == NEW { "NEW " } else { "OLD " }, cat);
+                    WHYSTAT.with(|m| *m.borrow_mut().entry(cat).or_insert(0) += 1);
+                }
                 continue;
             };
-            if verdict.min_gap_deg < min_gap {
+            if verdict.min_gap_deg < min_gap || verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG
+            {
                 FAILS.with(|f| f.borrow_mut()[level as usize][2] += 1);
                 continue;
             }
@@ -597,17 +746,37 @@ impl<'a> Mesher<'a> {
                     continue;
                 }
             }
+            // Look ahead: every thin wedge T leaves must be closable by a valid tet.
+            let closable = verdict.closings[..verdict.num_closings].iter().all(|c| {
+                let ct = c.map(|v| {
+                    if v == validity::NEW_POINT {
+                        cd.p
+                    } else {
+                        self.pts[v as usize]
+                    }
+                });
+                orient3d(ct[0], ct[1], ct[2], ct[3]) > 0
+                    && self.p2_nodes(*c, &ct).map_or(true, |x| curved_valid(&x))
+            });
+            if !closable && level < 2 {
+                FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
+                continue;
+            }
             chosen = Some(*cd);
             break;
         }
         if chosen.is_none() && level == 2 && std::env::var_os("CURVETET_DEBUG2").is_some() {
             let mut why = Vec::new();
             for cd in &cands {
-                let apex = if cd.id == NEW { u32::MAX - 1 } else { cd.id };
+                let apex = if cd.id == NEW {
+                    validity::NEW_POINT
+                } else {
+                    cd.id
+                };
                 let t = [f.v[0], f.v[1], f.v[2], apex];
                 let tp = [fp[0], fp[1], fp[2], cd.p];
                 let pts = &self.pts;
-                let v = validity::check(t, tp, &self.near, |i: u32| pts[i as usize]);
+                let v = validity::check(t, tp, &self.near, |i: u32| pts[i as usize], 0.0);
                 let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
                 let w = validity::WHY.with(|w| w.borrow().clone());
                 why.push(format!(
@@ -657,6 +826,17 @@ impl<'a> Mesher<'a> {
     }
 
     fn insert_tet(&mut self, t: [u32; 4], base: u32) {
+        if let Ok(tr) = std::env::var("CURVETET_TRACE") {
+            let set: Vec<u32> = tr.split(',').filter_map(|x| x.parse().ok()).collect();
+            if t.iter().filter(|x| set.contains(x)).count() >= 3 {
+                eprintln!(
+                    "TRACE tet {:?} base {:?} level {}",
+                    t,
+                    self.faces[base as usize].v,
+                    LEVEL.with(|l| *l.borrow())
+                );
+            }
+        }
         let tp = [0, 1, 2, 3].map(|k| self.pts[t[k] as usize]);
         self.volume_done += tet_det(tp[0], tp[1], tp[2], tp[3]) / 6.0;
         self.tets.push(t);

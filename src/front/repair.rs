@@ -4,10 +4,9 @@
 
 use super::grid::Aabb;
 use super::validity::TET_OUT_FACES;
-use super::{Key, Mesher};
+use super::Mesher;
 use crate::geom::vec3::*;
 use crate::Result;
-use std::cmp::Reverse;
 
 impl Mesher<'_> {
     /// Delete the tets around stuck front face `fid` and requeue the faces nearby.
@@ -68,8 +67,8 @@ impl Mesher<'_> {
             let f = &mut self.faces[i as usize];
             if f.tries != 0 {
                 f.tries = 0;
-                let p = self.face_pts(i);
-                self.heap.push(Reverse((0, Key(super::face_size(&p)), i)));
+                f.ver += 1;
+                self.enqueue(i);
             }
         }
         self.near_ids = ids;

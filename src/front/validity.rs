@@ -12,6 +12,7 @@
 //! force a sliver later.
 
 use super::grid::Aabb;
+use crate::geom::distance::point_triangle_dist2;
 use crate::geom::predicates::{orient3d, point_in_closed_tet, segment_triangle_conflict};
 use crate::geom::vec3::*;
 
@@ -25,43 +26,98 @@ pub struct Verdict {
     /// Smallest unmeshed wedge angle (degrees) between T and a front face sharing an edge
     /// with it; 360 when there is none.
     pub min_gap_deg: f64,
+    /// The same, against boundary (input) faces only.
+    pub min_gap_boundary_deg: f64,
+    /// Tets that will have to close the thin wedges T leaves against front faces (front
+    /// face + T's vertex across the wedge); the caller checks they can exist.
+    pub closings: [[u32; 4]; 6],
+    /// Number of entries in `closings`.
+    pub num_closings: usize,
 }
+
+/// Id the caller gives a candidate's apex when it is a new point.
+pub const NEW_POINT: u32 = u32::MAX - 1;
+
+/// Wedges thinner than this (degrees) are checked for a valid closing tet.
+pub const LOOKAHEAD_GAP_DEG: f64 = 35.0;
 
 /// One front face as the validity test sees it.
 #[derive(Clone, Copy)]
 pub struct FaceRef {
     /// Vertex ids, oriented with the normal into the unmeshed region.
     pub v: [u32; 3],
+    /// Is it an input (boundary) face?
+    pub boundary: bool,
 }
 
-/// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
-/// front, t[3] the apex) against the front faces `near` (excluding the base face).
-/// Returns `None` on any conflict.
-thread_local! { pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
+thread_local! {
+/// Debug: why the last check failed.
+pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
 fn why(s: String) {
     WHY.with(|w| *w.borrow_mut() = s);
 }
 
+/// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
+/// front, t[3] the apex) against the front faces `near` (excluding the base face).
+/// Returns `None` on any conflict. `min_dist` > 0 also rejects a new point (apex id
+/// [`NEW_POINT`]) that would come closer than that to an unrelated front face.
 pub fn check(
     t: [u32; 4],
     tp: [P3; 4],
     near: &[FaceRef],
     pos: impl Fn(u32) -> P3,
+    min_dist: f64,
 ) -> Option<Verdict> {
     if orient3d(tp[0], tp[1], tp[2], tp[3]) <= 0 {
         return None;
     }
     let tb = Aabb::of(&tp);
+    let tb_far = Aabb {
+        lo: [
+            tb.lo[0] - min_dist,
+            tb.lo[1] - min_dist,
+            tb.lo[2] - min_dist,
+        ],
+        hi: [
+            tb.hi[0] + min_dist,
+            tb.hi[1] + min_dist,
+            tb.hi[2] + min_dist,
+        ],
+    };
+    let min_d2 = min_dist * min_dist;
     let mut min_gap = 360.0f64;
+    let mut min_gap_b = 360.0f64;
+    let mut closings = [[0u32; 4]; 6];
+    let mut num_closings = 0;
     for f in near {
         let fv = f.v;
         let fp = [pos(fv[0]), pos(fv[1]), pos(fv[2])];
-        if !Aabb::of(&fp).overlaps(&tb) {
+        let fb = Aabb::of(&fp);
+        if !fb.overlaps(&tb_far) {
             continue;
         }
         let in_t = |id: u32| t.iter().position(|&x| x == id);
         let loc = [in_t(fv[0]), in_t(fv[1]), in_t(fv[2])];
         let shared = loc.iter().filter(|x| x.is_some()).count();
+        if shared == 0 && min_d2 > 0.0 && t[3] == NEW_POINT {
+            // Proximity: an unrelated front face must not come close to T's apex, nor
+            // its vertices close to T's new faces (a narrow gap would be left).
+            if point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2 {
+                why(format!("apex too close to {:?}", fv));
+                return None;
+            }
+            for q in fp {
+                for g in &TET_OUT_FACES[1..] {
+                    if point_triangle_dist2(q, tp[g[0]], tp[g[1]], tp[g[2]]) < min_d2 {
+                        why(format!("{:?} too close to a new face", fv));
+                        return None;
+                    }
+                }
+            }
+        }
+        if !fb.overlaps(&tb) {
+            continue;
+        }
         if shared == 3 {
             // F has T's three vertices: it must be a new face of T, oppositely oriented.
             let l = [loc[0].unwrap(), loc[1].unwrap(), loc[2].unwrap()];
@@ -89,8 +145,16 @@ pub fn check(
                 [Some(b), None, Some(a)] => (a, b, fp[1]),
                 _ => (0, 1, fp[0]), // unreachable: exactly two are shared
             };
-            let g = wedge_gap_deg(tp, e0, e1, fo, tri_normal(fp[0], fp[1], fp[2]));
+            let (g, k) = wedge_gap_deg(tp, e0, e1, fo, tri_normal(fp[0], fp[1], fp[2]));
             min_gap = min_gap.min(g);
+            let is_base_face = k != 3 && e0 != 3 && e1 != 3;
+            if g < LOOKAHEAD_GAP_DEG && !is_base_face && num_closings < closings.len() {
+                closings[num_closings] = [fv[0], fv[1], fv[2], t[k]];
+                num_closings += 1;
+            }
+            if f.boundary {
+                min_gap_b = min_gap_b.min(g);
+            }
         }
         if separated(&t, &tp, &fv, &fp) {
             continue;
@@ -131,6 +195,9 @@ pub fn check(
     }
     Some(Verdict {
         min_gap_deg: min_gap,
+        min_gap_boundary_deg: min_gap_b,
+        closings,
+        num_closings,
     })
 }
 
@@ -153,8 +220,9 @@ fn separated(t: &[u32; 4], tp: &[P3; 4], fv: &[u32; 3], fp: &[P3; 3]) -> bool {
 }
 
 /// Angle (degrees) swept from front face F's half-plane at edge (tp[e0], tp[e1]), turning
-/// towards F's normal `nf`, until the first face of T containing that edge.
-fn wedge_gap_deg(tp: [P3; 4], e0: usize, e1: usize, f_other: P3, nf: P3) -> f64 {
+/// towards F's normal `nf`, until the first face of T containing that edge, and the T
+/// vertex (local index) of that face opposite the edge.
+fn wedge_gap_deg(tp: [P3; 4], e0: usize, e1: usize, f_other: P3, nf: P3) -> (f64, usize) {
     let u = tp[e0];
     let t = normalize(sub(tp[e1], u));
     let perp = |x: P3| {
@@ -164,16 +232,20 @@ fn wedge_gap_deg(tp: [P3; 4], e0: usize, e1: usize, f_other: P3, nf: P3) -> f64 
     let e1v = normalize(perp(f_other));
     let e2v = normalize(sub(nf, scale(t, dot(nf, t))));
     let mut best = 360.0f64;
-    for k in 0..4 {
+    let mut best_k = 0;
+    for (k, &q) in tp.iter().enumerate() {
         if k == e0 || k == e1 {
             continue;
         }
-        let x = perp(tp[k]);
+        let x = perp(q);
         let mut ang = dot(x, e2v).atan2(dot(x, e1v)).to_degrees();
         if ang < 0.0 {
             ang += 360.0;
         }
-        best = best.min(ang);
+        if ang < best {
+            best = ang;
+            best_k = k;
+        }
     }
-    best
+    (best, best_k)
 }

@@ -2,6 +2,7 @@
 //! Bernstein (Bézier) bounds of the P2 tetrahedron's Jacobian, and quality metrics.
 
 pub mod bezier;
+pub mod distance;
 pub mod predicates;
 pub mod quadrature;
 pub mod quality;

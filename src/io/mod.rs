@@ -1,5 +1,5 @@
 //! Mesh files in and out: Gmsh .msh (2.2 and 4.1, ASCII and binary), VTK .vtu (XML) and
-//! legacy .vtk, and medit .mesh.
+//! legacy .vtk, and medit .mesh; linear triangle surfaces from STL, OFF, OBJ and PLY.
 //!
 //! | format | read | write |
 //! |---|---|---|
@@ -7,6 +7,16 @@
 //! | `.vtu` | ASCII and inline base64 `binary` arrays (UInt32/UInt64 header, uncompressed) | ASCII (default) or inline base64 binary |
 //! | `.vtk` | legacy ASCII `UNSTRUCTURED_GRID`, classic and 5.x `CELLS` layouts | legacy ASCII (version 4.2 layout) |
 //! | `.mesh` | ASCII medit (`Triangles`, `TrianglesP2`, `Tetrahedra`, `TetrahedraP2`) | ASCII medit, P2 (default) or linear |
+//! | `.stl` | ASCII and binary (3-node triangles, vertices welded exactly) | — |
+//! | `.off` | ASCII OFF and its COFF/NOFF/... variants, polygons split as fans | — |
+//! | `.obj` | `v` and `f` lines (`i`, `i/t`, `i//n`, `i/t/n`, negative indices), fans | — |
+//! | `.ply` | ASCII, binary little and big endian; `vertex` x y z, `face` index lists, fans | — |
+//!
+//! The linear formats hold only 3-node triangles ([`RawMesh::tri3`]); a linear surface
+//! becomes a P2 [`Surface`](crate::Surface) through [`read_any_surface`] (which curves it,
+//! see [`crate::surface::curve`]). Their vertices are welded exactly: identical
+//! coordinates become one vertex, and coordinates are kept bit-identical (`f32` values
+//! convert to `f64` exactly).
 //!
 //! Readers keep 3- and 6-node triangles and 4- and 10-node tetrahedra, converted to
 //! curvetet's (Gmsh) node order through [`order`]; other elements are counted in
@@ -37,19 +47,26 @@ use crate::geom::P3;
 use crate::mesh::TetMesh;
 
 mod cursor;
+mod linear;
+mod lines;
 mod medit;
 mod msh_read;
 mod msh_types;
 mod msh_write;
+mod obj;
+mod off;
 pub mod order;
+mod ply;
+mod stl;
 mod surface;
 mod text_out;
 mod vtk;
 mod vtk_cells;
 mod vtu;
 mod vtu_write;
+mod weld;
 
-pub use surface::{read_surface, surface_from_raw};
+pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
 pub const VOLUME_TAG: i32 = 1;
@@ -127,11 +144,19 @@ pub enum Format {
     Vtk,
     /// medit / Gamma mesh format `.mesh` (ASCII).
     Medit,
+    /// STL `.stl`, ASCII or binary (linear triangles; read only).
+    Stl,
+    /// Object File Format `.off`, ASCII (linear polygons; read only).
+    Off,
+    /// Wavefront `.obj` (linear polygons; read only).
+    Obj,
+    /// Stanford `.ply`, ASCII or binary (linear polygons; read only).
+    Ply,
 }
 
 impl Format {
-    /// The format of a path, from its extension (`.msh`, `.vtu`, `.vtk`, `.mesh`; any
-    /// case).
+    /// The format of a path, from its extension (`.msh`, `.vtu`, `.vtk`, `.mesh`, `.stl`,
+    /// `.off`, `.obj`, `.ply`; any case).
     pub fn from_path(path: &Path) -> Result<Format> {
         let ext = path
             .extension()
@@ -142,8 +167,13 @@ impl Format {
             Some("vtu") => Ok(Format::Vtu),
             Some("vtk") => Ok(Format::Vtk),
             Some("mesh") => Ok(Format::Medit),
+            Some("stl") => Ok(Format::Stl),
+            Some("off") => Ok(Format::Off),
+            Some("obj") => Ok(Format::Obj),
+            Some("ply") => Ok(Format::Ply),
             _ => Err(Error::InvalidArgument(format!(
-                "{}: unknown mesh file extension (expected .msh, .vtu, .vtk or .mesh)",
+                "{}: unknown mesh file extension (expected .msh, .vtu, .vtk, .mesh, .stl, .off, \
+                 .obj or .ply)",
                 path.display()
             ))),
         }
@@ -156,7 +186,20 @@ impl Format {
             Format::Vtu => "vtu",
             Format::Vtk => "vtk",
             Format::Medit => "mesh",
+            Format::Stl => "stl",
+            Format::Off => "off",
+            Format::Obj => "obj",
+            Format::Ply => "ply",
         }
+    }
+
+    /// Does curvetet write this format? (The linear surface formats are read only: they
+    /// cannot hold P2 elements.)
+    pub fn is_writable(self) -> bool {
+        matches!(
+            self,
+            Format::Msh | Format::Vtu | Format::Vtk | Format::Medit
+        )
     }
 }
 
@@ -175,6 +218,10 @@ pub fn read_bytes(bytes: &[u8], format: Format, name: &str) -> Result<RawMesh> {
         Format::Vtu => vtu::read(bytes, name)?,
         Format::Vtk => vtk::read(bytes, name)?,
         Format::Medit => medit::read(bytes, name)?,
+        Format::Stl => stl::read(bytes, name)?,
+        Format::Off => off::read(bytes, name)?,
+        Format::Obj => obj::read(bytes, name)?,
+        Format::Ply => ply::read(bytes, name)?,
     };
     debug_assert!(indices_in_range(&mesh));
     Ok(mesh)
@@ -266,10 +313,21 @@ fn write_view<W: Write>(
         Format::Vtu => vtu_write::write(w, view, opts.binary),
         Format::Vtk => vtk::write(w, view),
         Format::Medit => medit::write(w, view, opts.medit_linear),
+        // Refused by `check_options` before any byte is written.
+        Format::Stl | Format::Off | Format::Obj | Format::Ply => Err(std::io::Error::new(
+            std::io::ErrorKind::Unsupported,
+            "linear surface formats are read only",
+        )),
     }
 }
 
 fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result<()> {
+    if !format.is_writable() {
+        return Err(Error::InvalidArgument(format!(
+            ".{} is an input format for linear surfaces; write .msh, .vtu, .vtk or .mesh",
+            format.extension()
+        )));
+    }
     if opts.binary && matches!(format, Format::Vtk | Format::Medit) {
         return Err(Error::InvalidArgument(format!(
             "binary output is not available for .{} files",

@@ -1,14 +1,39 @@
 //! Reading an input surface from any mesh file we read.
 
 use super::RawMesh;
+use crate::surface::curve::{curve_linear, CurveOptions};
 use crate::{Error, Result, Surface, SurfaceDefect};
 use std::path::Path;
 
 /// Read the P2 surface in `path`: its 6-node triangles (with tags). A volume mesh's file
 /// works too (its boundary triangles are taken, other nodes dropped). A file holding only
-/// 3-node triangles is a [`SurfaceDefect::LinearSurface`] error.
+/// 3-node triangles is a [`SurfaceDefect::LinearSurface`] error: use [`read_any_surface`]
+/// to curve it.
 pub fn read_surface(path: &Path) -> Result<Surface> {
     surface_from_raw(super::read(path)?, &path.display().to_string())
+}
+
+/// Read a surface from `path`, P2 or linear: 6-node triangles are taken as they are (as
+/// [`read_surface`] does); a file with only 3-node triangles (STL, OFF, OBJ, PLY, or a
+/// linear .msh/.vtu/.vtk/.mesh) is curved into a P2 surface with `opts` (see
+/// [`crate::surface::curve`]).
+pub fn read_any_surface(path: &Path, opts: &CurveOptions) -> Result<Surface> {
+    surface_from_raw_any(super::read(path)?, &path.display().to_string(), opts)
+}
+
+/// The surface of a [`RawMesh`], P2 or linear (see [`read_any_surface`]); `name` is used
+/// in messages.
+pub fn surface_from_raw_any(raw: RawMesh, name: &str, opts: &CurveOptions) -> Result<Surface> {
+    if raw.tri6.is_empty() && !raw.tri3.is_empty() {
+        if !raw.tet4.is_empty() || !raw.tet10.is_empty() {
+            return Err(Error::surface(
+                SurfaceDefect::LinearSurface,
+                format!("{name}: a linear volume mesh; give its boundary surface instead"),
+            ));
+        }
+        return curve_linear(raw.nodes, raw.tri3, raw.tri3_tags, opts);
+    }
+    surface_from_raw(raw, name)
 }
 
 /// The P2 surface of a [`RawMesh`]; `name` is used in messages.
@@ -18,7 +43,8 @@ pub fn surface_from_raw(raw: RawMesh, name: &str) -> Result<Surface> {
             format!("{name}: no triangles found (a closed 6-node triangle surface is needed)")
         } else {
             format!(
-                "{name}: {} 3-node triangles and no 6-node ones; a quadratic (P2) surface is needed",
+                "{name}: {} 3-node triangles and no 6-node ones; a quadratic (P2) surface is \
+                 needed (curve it first: `curvetet curve`, or `io::read_any_surface`)",
                 raw.tri3.len()
             )
         };

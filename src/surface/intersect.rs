@@ -229,7 +229,19 @@ fn min_opt(a: Option<(u32, u32)>, b: Option<(u32, u32)>) -> Option<(u32, u32)> {
 /// pair of triangles), a degenerate sub-triangle, a sub-triangle conflict. Triangles
 /// must be non-degenerate.
 pub fn check_intersections(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
-    let n_sub = 4 * tris.len() as u32;
+    check_levels(nodes, tris, true)
+}
+
+/// The chord level of [`check_intersections`] only: the flat corner triangles, mid nodes
+/// ignored. This is the self-intersection check of a *linear* surface (used before it is
+/// curved, see `surface::curve`).
+pub fn check_chord_intersections(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
+    check_levels(nodes, tris, false)
+}
+
+/// Both levels (`curved`) or the chord level only.
+fn check_levels(nodes: &[P3], tris: &[[u32; 6]], curved: bool) -> Result<()> {
+    let n_sub = if curved { 4 * tris.len() as u32 } else { 0 };
     let degenerate: Vec<bool> = (0..n_sub)
         .into_par_iter()
         .map(|s| {
@@ -239,7 +251,13 @@ pub fn check_intersections(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
         .collect();
     let boxes: Vec<Aabb> = tris
         .par_iter()
-        .map(|t| bbox(t.map(|v| nodes[v as usize])))
+        .map(|t| {
+            if curved {
+                bbox(t.map(|v| nodes[v as usize]))
+            } else {
+                bbox([t[0], t[1], t[2]].map(|v| nodes[v as usize]))
+            }
+        })
         .collect();
     let grid = Grid::build(&boxes);
     let visit = |h: &mut Hits, i: u32, j: u32| {
@@ -253,7 +271,7 @@ pub fn check_intersections(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
                 h.chord = Some((i, j));
             }
         }
-        if h.chord.is_some() {
+        if h.chord.is_some() || !curved {
             return; // a chord conflict anywhere is reported before any curved one
         }
         let bi = SUB_TRIANGLES.map(|k| bbox(k.map(|q| xi[q])));
@@ -312,6 +330,9 @@ pub fn check_intersections(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
                 id[2]
             ),
         ));
+    }
+    if !curved {
+        return Ok(());
     }
     // Pairs of sub-triangles of the same triangle.
     let own = (0..tris.len() as u32).into_par_iter().find_map_first(|t| {

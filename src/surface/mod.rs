@@ -22,8 +22,13 @@
 //! 7. [`orientation`]: per shell, the exact sign of the enclosed chord volume and the
 //!    nesting depth (exact ray parity); an all-inward surface is flipped with a warning,
 //!    a mixed one is an error.
+//!
+//! A *linear* surface (3-node triangles, from STL/OFF/OBJ/PLY) becomes a P2 surface
+//! through [`curve`] ([`Surface::from_linear`]): the same checks on its flat triangles,
+//! then mid nodes on a smooth reconstruction, then `Surface::new`.
 
 pub mod coords;
+pub mod curve;
 pub mod demo;
 mod describe;
 mod exact_sum;

@@ -261,6 +261,10 @@ def main():
     with open(os.path.join(HERE, "EXPECTED.txt"), "w") as f:
         f.write("\n".join(expected) + "\n")
     print("wrote %d files to %s" % (len(expected), HERE))
+    # The linear files (make_bad_linear.py) add their lines to EXPECTED.txt.
+    import make_bad_linear
+
+    make_bad_linear.main()
 
 
 if __name__ == "__main__":

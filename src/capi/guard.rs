@@ -1,0 +1,162 @@
+//! The panic boundary and the argument checks every entry point goes through.
+//!
+//! Since Rust 1.81 a panic unwinding out of an `extern "C"` function aborts the host
+//! process, so every entry point runs its body inside [`status_call`] or [`value_call`],
+//! which catch the panic and turn it into `CURVETET_ERR_PANIC` with the panic message.
+
+use super::status::{clear_last_error, curvetet_status, set_last_error};
+use crate::{Error, Result};
+use std::any::Any;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+/// The text of a panic payload (`panic!` gives `&str` or `String`).
+fn panic_message(payload: &(dyn Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "(non-string panic payload)".to_string()
+    }
+}
+
+/// Record a caught panic and drop its payload without letting a second panic escape.
+fn record_panic(func: &str, payload: Box<dyn Any + Send>) {
+    set_last_error(&format!(
+        "{func}: internal error (panic): {}; please report this as a bug",
+        panic_message(&*payload)
+    ));
+    // A payload whose destructor panics must not unwind into C either.
+    let _ = catch_unwind(AssertUnwindSafe(move || drop(payload)));
+}
+
+/// A failed call: its status and message. Every [`Error`] converts into one (so `?`
+/// works in entry points); a few calls build their own for a more precise message.
+#[derive(Debug)]
+pub(crate) struct Failure {
+    pub status: curvetet_status,
+    pub msg: String,
+}
+
+impl From<Error> for Failure {
+    fn from(e: Error) -> Failure {
+        Failure {
+            status: curvetet_status::of(&e),
+            msg: e.to_string(),
+        }
+    }
+}
+
+/// Run the body of a status-returning entry point `func`: `Ok` clears the last error and
+/// gives `CURVETET_OK`; an error records its message (prefixed with `func`) and gives its
+/// status code; a panic gives `CURVETET_ERR_PANIC`.
+pub(crate) fn status_call(
+    func: &str,
+    body: impl FnOnce() -> std::result::Result<(), Failure>,
+) -> curvetet_status {
+    match catch_unwind(AssertUnwindSafe(body)) {
+        Ok(Ok(())) => {
+            clear_last_error();
+            curvetet_status::CURVETET_OK
+        }
+        Ok(Err(f)) => {
+            set_last_error(&format!("{func}: {}", f.msg));
+            f.status
+        }
+        Err(payload) => {
+            record_panic(func, payload);
+            curvetet_status::CURVETET_ERR_PANIC
+        }
+    }
+}
+
+/// Run the body of an accessor `func` that returns a value rather than a status: an
+/// error or a panic records the message and gives `fallback`; success leaves the last
+/// error as it was (so it can still be read after a failed call).
+pub(crate) fn value_call<T>(func: &str, fallback: T, body: impl FnOnce() -> Result<T>) -> T {
+    match catch_unwind(AssertUnwindSafe(body)) {
+        Ok(Ok(v)) => v,
+        Ok(Err(e)) => {
+            set_last_error(&format!("{func}: {e}"));
+            fallback
+        }
+        Err(payload) => {
+            record_panic(func, payload);
+            fallback
+        }
+    }
+}
+
+/// An invalid-argument error.
+pub(crate) fn invalid(msg: impl Into<String>) -> Error {
+    Error::InvalidArgument(msg.into())
+}
+
+/// `p` as a shared reference, or an error naming the parameter when it is NULL or
+/// misaligned.
+///
+/// # Safety
+/// A non-NULL `p` must point to a live `T` for the lifetime the caller picks.
+pub(crate) unsafe fn deref<'a, T>(p: *const T, name: &str) -> Result<&'a T> {
+    check_ptr(p, name)?;
+    // SAFETY: non-NULL and aligned (checked); validity is the caller's contract.
+    Ok(unsafe { &*p })
+}
+
+/// Error when `p` is NULL or not aligned for `T`.
+pub(crate) fn check_ptr<T>(p: *const T, name: &str) -> Result<()> {
+    if p.is_null() {
+        return Err(invalid(format!("{name} is NULL")));
+    }
+    if !p.is_aligned() {
+        return Err(invalid(format!(
+            "{name} ({p:p}) is not aligned to {} bytes",
+            std::mem::align_of::<T>()
+        )));
+    }
+    Ok(())
+}
+
+/// `len` elements of `T` starting at `p` as a slice. `p` may be NULL only when `len` is
+/// 0. `what` names the parameter and `count` the count it was derived from.
+///
+/// # Safety
+/// A non-NULL `p` must point to `len` initialised `T`s that stay unchanged while the
+/// slice is used.
+pub(crate) unsafe fn input_slice<'a, T>(p: *const T, len: usize, what: &str) -> Result<&'a [T]> {
+    if len == 0 {
+        return Ok(&[]);
+    }
+    check_ptr(p, what)?;
+    if len
+        .checked_mul(std::mem::size_of::<T>())
+        .map_or(true, |b| b > isize::MAX as usize)
+    {
+        return Err(invalid(format!("{what}: {len} elements is too many")));
+    }
+    // SAFETY: non-NULL, aligned, size fits isize (checked); contents are the caller's
+    // contract (documented in the header).
+    Ok(unsafe { std::slice::from_raw_parts(p, len) })
+}
+
+/// `n * k` elements, or an error when it overflows.
+pub(crate) fn times(n: usize, k: usize, what: &str) -> Result<usize> {
+    n.checked_mul(k)
+        .ok_or_else(|| invalid(format!("{what}: count {n} overflows")))
+}
+
+/// Copy `values` to the caller's buffer `out`, which must hold `values.len()` elements.
+/// `out` may be NULL only when there is nothing to copy.
+///
+/// # Safety
+/// A non-NULL `out` must be valid for writing `values.len()` elements.
+pub(crate) unsafe fn copy_out<T: Copy>(values: &[T], out: *mut T, name: &str) -> Result<()> {
+    if values.is_empty() {
+        return Ok(());
+    }
+    check_ptr(out.cast_const(), name)?;
+    // SAFETY: `out` is non-NULL and aligned (checked) and holds values.len() elements by
+    // the documented contract; a Rust slice never overlaps a caller's buffer we write.
+    unsafe { std::ptr::copy_nonoverlapping(values.as_ptr(), out, values.len()) };
+    Ok(())
+}

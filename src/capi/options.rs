@@ -1,0 +1,160 @@
+//! `curvetet_options`: the versioned options struct, and its conversion to [`Options`].
+//!
+//! Versioning: the caller puts `sizeof(curvetet_options)` of the header it was compiled
+//! with in `struct_size`. A library reads only the fields that fit in `struct_size`
+//! (fields a smaller, older struct lacks take their defaults) and refuses:
+//! - a `struct_size` smaller than the first version's ([`OPTIONS_SIZE_V1`]): it was never
+//!   set (0) or is garbage;
+//! - a `struct_size` above [`MAX_STRUCT_SIZE`] (garbage);
+//! - a larger, newer struct whose bytes past this library's `sizeof` are not all zero:
+//!   the caller set options this library does not know, and ignoring them would be silent.
+
+use super::guard::{check_ptr, invalid};
+use crate::{Options, Result, SizeMode};
+use std::ffi::{c_char, c_int, c_void};
+use std::mem::{offset_of, size_of};
+
+/// Progress callback: called from the thread that called `curvetet_generate`, with the
+/// fraction of the work done (0..1, non-decreasing within a stage) and a short stage
+/// name ("front", "certify"; the string is valid only during the call). Return nonzero
+/// to cancel: `curvetet_generate` then returns `CURVETET_ERR_CANCELLED` promptly. It must
+/// not unwind (throw a C++ exception or `longjmp`) through curvetet.
+#[allow(non_camel_case_types)] // the C name fixed by the ABI contract
+pub type curvetet_progress_fn = Option<
+    unsafe extern "C" fn(user_data: *mut c_void, fraction: f64, stage: *const c_char) -> c_int,
+>;
+
+/// Options of `curvetet_generate`. Initialise with `curvetet_options_default` (or
+/// `curvetet_options_init`), then change fields.
+#[allow(non_camel_case_types)] // the C name fixed by the ABI contract
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct curvetet_options {
+    /// `sizeof(curvetet_options)`: lets the struct grow. Set by `curvetet_options_default`.
+    pub struct_size: u32,
+    /// Search radius factor: candidates within alpha * h of the ideal point (default 1.5,
+    /// the paper's). Must be finite and > 0.
+    pub alpha: f64,
+    /// Target edge length; <= 0 (default): graded from the surface's triangle sizes.
+    /// NaN or +infinity is an error.
+    pub size: f64,
+    /// Nonzero (default 1): quality improvement and high-order optimization.
+    pub optimize: i32,
+    /// Worker threads for the parallel stages; 0 (default): all cores. The result does
+    /// not depend on it.
+    pub threads: u32,
+    /// Progress callback; may be NULL (default).
+    pub progress: curvetet_progress_fn,
+    /// Passed to `progress` unchanged; may be NULL.
+    pub user_data: *mut c_void,
+}
+
+/// `sizeof(curvetet_options)` of the first version of the ABI (curvetet 0.1): every
+/// accepted struct has at least these fields.
+pub const OPTIONS_SIZE_V1: usize =
+    offset_of!(curvetet_options, user_data) + size_of::<*mut c_void>();
+
+/// Largest `struct_size` accepted for a versioned struct: bigger is garbage.
+pub(crate) const MAX_STRUCT_SIZE: usize = 4096;
+
+impl curvetet_options {
+    /// The defaults, with `struct_size` = this library's `sizeof(curvetet_options)`.
+    pub fn defaults() -> curvetet_options {
+        let d = Options::default();
+        curvetet_options {
+            struct_size: size_of::<curvetet_options>() as u32,
+            alpha: d.alpha,
+            size: 0.0,
+            optimize: d.optimize as i32,
+            threads: d.threads as u32,
+            progress: None,
+            user_data: std::ptr::null_mut(),
+        }
+    }
+}
+
+/// Check a versioned struct's `struct_size` (the first field): between `v1` and
+/// [`MAX_STRUCT_SIZE`]. `what` names the struct.
+pub(crate) fn check_struct_size(size: usize, v1: usize, what: &str) -> Result<()> {
+    if size < v1 {
+        return Err(invalid(format!(
+            "{what}->struct_size is {size}, smaller than the first version's {v1}: set it to \
+             sizeof({what})"
+        )));
+    }
+    if size > MAX_STRUCT_SIZE {
+        return Err(invalid(format!(
+            "{what}->struct_size is {size}, larger than any version ({MAX_STRUCT_SIZE} at \
+             most): is the struct initialised?"
+        )));
+    }
+    Ok(())
+}
+
+/// What `curvetet_generate` takes from a `curvetet_options`.
+pub(crate) struct Parsed {
+    pub options: Options,
+    pub progress: curvetet_progress_fn,
+    pub user_data: *mut c_void,
+}
+
+/// Read the caller's options (NULL: defaults), honouring `struct_size`.
+///
+/// # Safety
+/// A non-NULL `p` must point to at least `p->struct_size` readable bytes.
+pub(crate) unsafe fn parse(p: *const curvetet_options) -> Result<Parsed> {
+    let mut o = curvetet_options::defaults();
+    if !p.is_null() {
+        check_ptr(p, "opt")?;
+        // SAFETY: non-NULL and aligned; struct_size is the first field, present in every
+        // version.
+        let size = unsafe { std::ptr::addr_of!((*p).struct_size).read() } as usize;
+        check_struct_size(size, OPTIONS_SIZE_V1, "curvetet_options")?;
+        let ours = size_of::<curvetet_options>();
+        if size > ours {
+            // SAFETY: the caller promises `size` readable bytes (<= MAX_STRUCT_SIZE).
+            let extra =
+                unsafe { std::slice::from_raw_parts(p.cast::<u8>().add(ours), size - ours) };
+            if let Some(k) = extra.iter().position(|&b| b != 0) {
+                return Err(invalid(format!(
+                    "curvetet_options->struct_size is {size}, from a newer curvetet; byte {} \
+                     is set but this library ({}) knows only the first {ours} bytes",
+                    ours + k,
+                    env!("CARGO_PKG_VERSION")
+                )));
+            }
+        }
+        // Copy field `$f` when the caller's struct is big enough to hold it.
+        macro_rules! take {
+            ($f:ident) => {
+                if offset_of!(curvetet_options, $f) + size_of_val(&o.$f) <= size {
+                    // SAFETY: the field lies within the caller's `size` bytes.
+                    o.$f = unsafe { std::ptr::addr_of!((*p).$f).read() };
+                }
+            };
+        }
+        take!(alpha);
+        take!(size);
+        take!(optimize);
+        take!(threads);
+        take!(progress);
+        take!(user_data);
+    }
+    let mut options = Options {
+        alpha: o.alpha,
+        optimize: o.optimize != 0,
+        threads: o.threads as usize,
+        ..Options::default()
+    };
+    options.size = if o.size.is_nan() || o.size > 0.0 {
+        SizeMode::Fixed(o.size) // NaN and infinity are rejected by validate()
+    } else {
+        SizeMode::Graded
+    };
+    options.validate()?;
+    Ok(Parsed {
+        options,
+        progress: o.progress,
+        user_data: o.user_data,
+    })
+}

@@ -1,0 +1,283 @@
+//! `curvetet_surface`: a checked, immutable P2 surface behind an opaque handle.
+
+use super::guard::{
+    check_ptr, copy_out, deref, input_slice, invalid, status_call, times, value_call,
+};
+use super::status::curvetet_status;
+use crate::{Result, Surface};
+use std::ffi::{c_char, CStr, CString};
+use std::path::PathBuf;
+
+/// A closed quadratic (6-node) triangle surface, checked on creation (closed, manifold,
+/// consistently oriented, no self-intersection, ...). Opaque. Immutable once created, so
+/// it may be used from several threads at once (e.g. two `curvetet_generate` calls).
+#[allow(non_camel_case_types)] // the C name fixed by the ABI contract
+pub struct curvetet_surface {
+    pub(crate) surface: Surface,
+    /// The surface's warnings as C strings (owned here, handed out by pointer).
+    warnings: Vec<CString>,
+}
+
+impl curvetet_surface {
+    fn new(surface: Surface) -> curvetet_surface {
+        let warnings = surface
+            .warnings()
+            .iter()
+            .map(|w| CString::new(w.replace('\0', "\\0")).unwrap_or_default())
+            .collect();
+        curvetet_surface { surface, warnings }
+    }
+}
+
+/// Store a new handle in `*out`.
+///
+/// # Safety
+/// `out` is non-NULL and aligned (checked by the caller of this helper).
+unsafe fn give(out: *mut *mut curvetet_surface, s: Surface) {
+    // SAFETY: see above.
+    unsafe { *out = Box::into_raw(Box::new(curvetet_surface::new(s))) };
+}
+
+/// Set `*out` to NULL first, so that it is NULL on every failure.
+///
+/// # Safety
+/// A non-NULL `out` must be valid for writing one pointer.
+pub(crate) unsafe fn reset_out<T>(out: *mut *mut T) -> Result<()> {
+    super::guard::check_ptr(out.cast_const(), "out")?;
+    // SAFETY: non-NULL and aligned (checked); writable by contract.
+    unsafe { *out = std::ptr::null_mut() };
+    Ok(())
+}
+
+/// A C path string as a filesystem path (bytes on Unix, so any file name works).
+///
+/// # Safety
+/// A non-NULL `path` must be a NUL-terminated string.
+pub(crate) unsafe fn c_path(path: *const c_char) -> Result<PathBuf> {
+    if path.is_null() {
+        return Err(invalid("path is NULL"));
+    }
+    // SAFETY: non-NULL; NUL-terminated by contract.
+    let c = unsafe { CStr::from_ptr(path) };
+    if c.is_empty() {
+        return Err(invalid("path is empty"));
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        Ok(PathBuf::from(std::ffi::OsStr::from_bytes(c.to_bytes())))
+    }
+    #[cfg(not(unix))]
+    {
+        c.to_str()
+            .map(PathBuf::from)
+            .map_err(|_| invalid("path is not valid UTF-8"))
+    }
+}
+
+/// Build a surface from arrays, copying them (the arrays may be freed afterwards).
+///
+/// - `xyz`: `3 * num_nodes` coordinates (x0, y0, z0, x1, ...).
+/// - `tri6`: `6 * num_triangles` 0-based node indices per triangle, corners first, then
+///   the mid-edge nodes of edges (0,1), (1,2), (2,0) (Gmsh's and VTK's order), outward
+///   (right-hand rule). A consistently inward surface is flipped, with a warning (see
+///   `curvetet_surface_num_warnings`).
+/// - `tags`: `num_triangles` tags (e.g. Gmsh physical tags) kept on the boundary of the
+///   mesh, or NULL for all 0.
+///
+/// On success `*out` is a new surface the caller owns (free it with
+/// `curvetet_surface_free`). On failure `*out` is NULL and the status is
+/// `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, count
+/// overflow) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and
+/// the triangle, edge or node).
+///
+/// # Safety
+/// Each non-NULL array must hold the number of elements stated above.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_from_arrays(
+    xyz: *const f64,
+    num_nodes: usize,
+    tri6: *const u32,
+    num_triangles: usize,
+    tags: *const i32,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    status_call("curvetet_surface_from_arrays", || {
+        // SAFETY: `out` is the caller's; checked inside.
+        unsafe { reset_out(out)? };
+        let n3 = times(num_nodes, 3, "num_nodes")?;
+        let t6 = times(num_triangles, 6, "num_triangles")?;
+        // SAFETY: lengths as documented; NULL/alignment/size checked inside.
+        let (xyz, tri6) = unsafe { (input_slice(xyz, n3, "xyz")?, input_slice(tri6, t6, "tri6")?) };
+        let tags = if tags.is_null() {
+            Vec::new()
+        } else {
+            // SAFETY: as above.
+            unsafe { input_slice(tags, num_triangles, "tags")? }.to_vec()
+        };
+        let nodes: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let tris: Vec<[u32; 6]> = tri6
+            .chunks_exact(6)
+            .map(|c| std::array::from_fn(|k| c[k]))
+            .collect();
+        let s = Surface::new(nodes, tris, tags)?;
+        // SAFETY: `out` checked by reset_out.
+        unsafe { give(out, s) };
+        Ok(())
+    })
+}
+
+/// Read a P2 surface from a file: Gmsh `.msh` (2.2/4.1, ASCII/binary), VTK `.vtu`/`.vtk`,
+/// or medit `.mesh`, by extension. A volume mesh's file works too (its boundary
+/// triangles are taken). The surface is checked as in `curvetet_surface_from_arrays`.
+///
+/// On success `*out` is a new surface the caller owns (free it with
+/// `curvetet_surface_free`). On failure `*out` is NULL and the status is
+/// `CURVETET_ERR_INVALID_ARGUMENT` (NULL or empty `path`, NULL `out`, unknown extension),
+/// `CURVETET_ERR_IO` (cannot open/read), `CURVETET_ERR_PARSE` (malformed; the message
+/// gives file:line) or `CURVETET_ERR_INVALID_SURFACE`.
+///
+/// # Safety
+/// `path` must be NULL or a NUL-terminated string.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_read(
+    path: *const c_char,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    status_call("curvetet_surface_read", || {
+        // SAFETY: checked inside.
+        unsafe { reset_out(out)? };
+        // SAFETY: NUL-terminated by contract.
+        let path = unsafe { c_path(path)? };
+        let s = crate::io::read_surface(&path)?;
+        // SAFETY: `out` checked by reset_out.
+        unsafe { give(out, s) };
+        Ok(())
+    })
+}
+
+/// Free a surface. NULL is fine. Meshes generated from it stay valid (they own their
+/// data). The surface must not be in use by another thread (e.g. in `curvetet_generate`).
+///
+/// # Safety
+/// `s` must be NULL or a surface from this library not yet freed.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_free(s: *mut curvetet_surface) {
+    if !s.is_null() {
+        value_call("curvetet_surface_free", (), || {
+            // SAFETY: created by Box::into_raw in this module, not yet freed (contract).
+            drop(unsafe { Box::from_raw(s) });
+            Ok(())
+        })
+    }
+}
+
+/// Number of nodes (corners and mid-edge nodes) of the surface; 0 if `s` is NULL (and
+/// the last error message says so).
+///
+/// # Safety
+/// `s` must be NULL or a live surface.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_num_nodes(s: *const curvetet_surface) -> usize {
+    value_call("curvetet_surface_num_nodes", 0, || {
+        // SAFETY: live by contract.
+        Ok(unsafe { deref(s, "s")? }.surface.nodes().len())
+    })
+}
+
+/// Number of 6-node triangles of the surface; 0 if `s` is NULL (and the last error
+/// message says so).
+///
+/// # Safety
+/// `s` must be NULL or a live surface.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_num_triangles(s: *const curvetet_surface) -> usize {
+    value_call("curvetet_surface_num_triangles", 0, || {
+        // SAFETY: live by contract.
+        Ok(unsafe { deref(s, "s")? }.surface.triangles().len())
+    })
+}
+
+/// The surface's node coordinates: `3 * curvetet_surface_num_nodes(s)` doubles (x0, y0,
+/// z0, x1, ...), owned by `s` and valid until it is freed. NULL if `s` is NULL (and the
+/// last error message says so).
+///
+/// # Safety
+/// `s` must be NULL or a live surface.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_nodes(s: *const curvetet_surface) -> *const f64 {
+    value_call("curvetet_surface_nodes", std::ptr::null(), || {
+        // SAFETY: live by contract.
+        Ok(unsafe { deref(s, "s")? }
+            .surface
+            .nodes()
+            .as_ptr()
+            .cast::<f64>())
+    })
+}
+
+/// Copy the surface's triangles: `tri6_out` receives `6 * curvetet_surface_num_triangles(s)`
+/// 0-based node indices (Gmsh order, outward: after a flip these are the flipped
+/// triangles), `tags_out` (may be NULL) one tag per triangle.
+///
+/// Errors: `CURVETET_ERR_INVALID_ARGUMENT` when `s` or `tri6_out` is NULL.
+///
+/// # Safety
+/// `s` must be a live surface; the buffers must hold the counts above.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_triangles(
+    s: *const curvetet_surface,
+    tri6_out: *mut u32,
+    tags_out: *mut i32,
+) -> curvetet_status {
+    status_call("curvetet_surface_triangles", || {
+        // SAFETY: live by contract.
+        let s = unsafe { deref(s, "s")? };
+        check_ptr(tri6_out.cast_const(), "tri6_out")?;
+        let tris = s.surface.triangles();
+        // SAFETY: buffer sizes by contract; NULL/alignment checked inside.
+        unsafe {
+            copy_out(tris.as_flattened(), tri6_out, "tri6_out")?;
+            if !tags_out.is_null() {
+                copy_out(s.surface.tags(), tags_out, "tags_out")?;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Number of warnings raised while checking the surface (e.g. "orientation was inward;
+/// flipped"); 0 if `s` is NULL.
+///
+/// # Safety
+/// `s` must be NULL or a live surface.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_num_warnings(s: *const curvetet_surface) -> usize {
+    value_call("curvetet_surface_num_warnings", 0, || {
+        // SAFETY: live by contract.
+        Ok(unsafe { deref(s, "s")? }.warnings.len())
+    })
+}
+
+/// Warning `i` (0-based) as a NUL-terminated string owned by `s` (valid until it is
+/// freed); NULL if `s` is NULL or `i` is out of range (and the last error message says
+/// so).
+///
+/// # Safety
+/// `s` must be NULL or a live surface.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_warning(
+    s: *const curvetet_surface,
+    i: usize,
+) -> *const c_char {
+    value_call("curvetet_surface_warning", std::ptr::null(), || {
+        // SAFETY: live by contract.
+        let s = unsafe { deref(s, "s")? };
+        s.warnings.get(i).map(|w| w.as_ptr()).ok_or_else(|| {
+            invalid(format!(
+                "warning {i} does not exist ({} warnings)",
+                s.warnings.len()
+            ))
+        })
+    })
+}

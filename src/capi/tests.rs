@@ -1,0 +1,359 @@
+//! Rust-side tests of the C ABI: the panic boundary, status mapping, struct versioning
+//! and argument checks. The C programs in tests/c exercise the same functions from C.
+
+use super::guard::{status_call, value_call};
+use super::options::{parse, MAX_STRUCT_SIZE};
+use super::*;
+use crate::{Error, SizeMode, SurfaceDefect};
+use std::ffi::{c_void, CStr, CString};
+use std::ptr::{null, null_mut};
+
+fn last_error() -> String {
+    // SAFETY: never NULL, NUL-terminated.
+    unsafe { CStr::from_ptr(curvetet_last_error_message()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn sphere_path() -> CString {
+    let p = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/sphere_p2.msh");
+    CString::new(p).unwrap()
+}
+
+#[test]
+fn a_panic_becomes_a_status_with_its_message() {
+    let st = status_call("f", || panic!("boom {}", 42));
+    assert_eq!(st, curvetet_status::CURVETET_ERR_PANIC);
+    let msg = last_error();
+    assert!(msg.contains("f:") && msg.contains("boom 42"), "{msg}");
+    let v = value_call("g", 7usize, || -> crate::Result<usize> {
+        panic!("static str")
+    });
+    assert_eq!(v, 7);
+    assert!(last_error().contains("static str"));
+    // A success clears the message.
+    assert_eq!(status_call("h", || Ok(())), curvetet_status::CURVETET_OK);
+    assert_eq!(last_error(), "");
+}
+
+#[test]
+fn every_error_maps_to_its_stable_code() {
+    use curvetet_status::*;
+    let io = std::io::Error::new(std::io::ErrorKind::NotFound, "x");
+    let cases = [
+        (
+            Error::InvalidArgument("a".into()),
+            CURVETET_ERR_INVALID_ARGUMENT,
+            1,
+        ),
+        (Error::io("p", io), CURVETET_ERR_IO, 2),
+        (Error::parse("f:1", "bad"), CURVETET_ERR_PARSE, 3),
+        (
+            Error::surface(SurfaceDefect::NotClosed, "edge"),
+            CURVETET_ERR_INVALID_SURFACE,
+            4,
+        ),
+        (
+            Error::MeshingFailed {
+                msg: "m".into(),
+                partial: None,
+            },
+            CURVETET_ERR_MESHING_FAILED,
+            5,
+        ),
+        (
+            Error::InvalidMesh {
+                elements: vec![],
+                msg: "m".into(),
+                mesh: None,
+            },
+            CURVETET_ERR_INVALID_MESH,
+            6,
+        ),
+        (Error::Cancelled, CURVETET_ERR_CANCELLED, 7),
+    ];
+    for (e, st, code) in cases {
+        assert_eq!(curvetet_status::of(&e), st);
+        assert_eq!(st as i32, code);
+        assert_eq!(curvetet_status::from_int(code), Some(st));
+    }
+    assert_eq!(CURVETET_OK as i32, 0);
+    assert_eq!(CURVETET_ERR_PANIC as i32, 8);
+    for code in 0..=8 {
+        let name = unsafe { CStr::from_ptr(curvetet_error_name(StatusArg(code))) };
+        assert!(name.to_str().unwrap().starts_with("CURVETET_"));
+    }
+    let name = unsafe { CStr::from_ptr(curvetet_error_name(StatusArg(99))) };
+    assert_eq!(name.to_str().unwrap(), "CURVETET_UNKNOWN_STATUS");
+    let name = unsafe { CStr::from_ptr(curvetet_error_name(StatusArg(-1))) };
+    assert_eq!(name.to_str().unwrap(), "CURVETET_UNKNOWN_STATUS");
+}
+
+#[test]
+fn version_is_the_crate_version() {
+    let v = unsafe { CStr::from_ptr(curvetet_version()) };
+    assert_eq!(v.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
+}
+
+#[test]
+fn options_struct_size_is_checked() {
+    let mut o = std::mem::MaybeUninit::<curvetet_options>::uninit();
+    unsafe { curvetet_options_default(o.as_mut_ptr()) };
+    let o = unsafe { o.assume_init() };
+    assert_eq!(
+        o.struct_size as usize,
+        std::mem::size_of::<curvetet_options>()
+    );
+    assert_eq!(o.struct_size as usize, OPTIONS_SIZE_V1);
+    let p = unsafe { parse(&o) }.unwrap();
+    assert_eq!(p.options.alpha, 1.5);
+    assert!(p.options.optimize);
+    assert_eq!(p.options.size, SizeMode::Graded);
+    assert!(unsafe { parse(null()) }.is_ok());
+
+    for bad in [
+        0u32,
+        4,
+        OPTIONS_SIZE_V1 as u32 - 1,
+        MAX_STRUCT_SIZE as u32 + 1,
+    ] {
+        let mut b = o;
+        b.struct_size = bad;
+        let e = unsafe { parse(&b) }.err().expect("rejected");
+        assert!(e.to_string().contains("struct_size"), "{e}");
+    }
+
+    // A newer, bigger struct: accepted when its extra bytes are zero.
+    #[repr(C)]
+    struct Newer {
+        base: curvetet_options,
+        extra: [u64; 4],
+    }
+    let mut n = Newer {
+        base: o,
+        extra: [0; 4],
+    };
+    n.base.struct_size = std::mem::size_of::<Newer>() as u32;
+    n.base.alpha = 2.0;
+    let p = unsafe { parse(&n.base) }.unwrap();
+    assert_eq!(p.options.alpha, 2.0);
+    n.extra[2] = 1;
+    let e = unsafe { parse(&n.base) }.err().expect("unknown field set");
+    assert!(e.to_string().contains("newer"), "{e}");
+
+    // curvetet_options_init fills a newer struct's tail with zeros.
+    let mut n = Newer {
+        base: o,
+        extra: [u64::MAX; 4],
+    };
+    let st = unsafe { curvetet_options_init(&mut n.base, std::mem::size_of::<Newer>()) };
+    assert_eq!(st, curvetet_status::CURVETET_OK);
+    assert_eq!(n.extra, [0; 4]);
+    assert_eq!(n.base.struct_size as usize, std::mem::size_of::<Newer>());
+    assert!(unsafe { parse(&n.base) }.is_ok());
+    let st = unsafe { curvetet_options_init(&mut n.base, 3) };
+    assert_eq!(st, curvetet_status::CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(last_error().contains("struct_size"));
+    let st = unsafe { curvetet_options_init(null_mut(), OPTIONS_SIZE_V1) };
+    assert_eq!(st, curvetet_status::CURVETET_ERR_INVALID_ARGUMENT);
+}
+
+#[test]
+fn option_values_are_validated() {
+    let mut o = curvetet_options::defaults();
+    o.size = -1.0;
+    assert_eq!(unsafe { parse(&o) }.unwrap().options.size, SizeMode::Graded);
+    o.size = 0.25;
+    assert_eq!(
+        unsafe { parse(&o) }.unwrap().options.size,
+        SizeMode::Fixed(0.25)
+    );
+    for (alpha, size) in [
+        (f64::NAN, 0.0),
+        (-1.0, 0.0),
+        (1.5, f64::NAN),
+        (1.5, f64::INFINITY),
+    ] {
+        o.alpha = alpha;
+        o.size = size;
+        assert!(matches!(
+            unsafe { parse(&o) },
+            Err(Error::InvalidArgument(_))
+        ));
+    }
+}
+
+#[test]
+fn null_and_misaligned_pointers_are_rejected() {
+    use curvetet_status::*;
+    let mut s: *mut curvetet_surface = 8 as *mut _; // not NULL: must be reset
+    let st = unsafe { curvetet_surface_read(null(), &mut s) };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(s.is_null());
+    assert!(last_error().contains("path is NULL"));
+    let st = unsafe { curvetet_surface_read(sphere_path().as_ptr(), null_mut()) };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(last_error().contains("out is NULL"));
+    let st = unsafe { curvetet_surface_from_arrays(null(), 3, null(), 0, null(), &mut s) };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(last_error().contains("xyz is NULL"), "{}", last_error());
+    // No triangles at all is a surface defect, not an argument error.
+    let st = unsafe { curvetet_surface_from_arrays(null(), 0, null(), 0, null(), &mut s) };
+    assert_eq!(st, CURVETET_ERR_INVALID_SURFACE);
+    // A count whose byte size overflows.
+    let xyz = [0.0f64; 3];
+    let st = unsafe {
+        curvetet_surface_from_arrays(xyz.as_ptr(), usize::MAX / 2, null(), 0, null(), &mut s)
+    };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    // Misaligned.
+    let bytes = [0u8; 64];
+    let odd = bytes.as_ptr().wrapping_add(1).cast::<f64>();
+    let st = unsafe { curvetet_surface_from_arrays(odd, 1, null(), 0, null(), &mut s) };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(last_error().contains("aligned"), "{}", last_error());
+
+    let mut m: *mut curvetet_mesh = 8 as *mut _;
+    assert_eq!(
+        unsafe { curvetet_generate(null(), null(), &mut m) },
+        CURVETET_ERR_INVALID_ARGUMENT
+    );
+    assert!(m.is_null());
+    assert_eq!(unsafe { curvetet_mesh_num_nodes(null()) }, 0);
+    assert!(last_error().contains("m is NULL"));
+    assert!(unsafe { curvetet_mesh_nodes(null()) }.is_null());
+    assert!(unsafe { curvetet_mesh_report_json(null()) }.is_null());
+    assert_eq!(unsafe { curvetet_surface_num_nodes(null()) }, 0);
+    unsafe { curvetet_surface_free(null_mut()) };
+    unsafe { curvetet_mesh_free(null_mut()) };
+}
+
+extern "C" fn cancel_at_third_call(user: *mut c_void, fraction: f64, stage: *const c_char) -> i32 {
+    // SAFETY: the test passes a *mut Vec<(f64, String)>.
+    let calls = unsafe { &mut *user.cast::<Vec<(f64, String)>>() };
+    let stage = unsafe { CStr::from_ptr(stage) }
+        .to_string_lossy()
+        .into_owned();
+    calls.push((fraction, stage));
+    (calls.len() >= 3) as i32
+}
+
+#[test]
+fn generate_through_the_abi() {
+    use curvetet_status::*;
+    let mut s = null_mut();
+    assert_eq!(
+        unsafe { curvetet_surface_read(sphere_path().as_ptr(), &mut s) },
+        CURVETET_OK
+    );
+    assert_eq!(last_error(), "");
+    let (nn, nt) = unsafe {
+        (
+            curvetet_surface_num_nodes(s),
+            curvetet_surface_num_triangles(s),
+        )
+    };
+    assert!(nn > 0 && nt > 0);
+
+    // Cancelled at the third progress report.
+    let mut calls: Vec<(f64, String)> = Vec::new();
+    let mut o = curvetet_options::defaults();
+    o.progress = Some(cancel_at_third_call);
+    o.user_data = (&mut calls as *mut Vec<(f64, String)>).cast();
+    let mut m = null_mut();
+    assert_eq!(
+        unsafe { curvetet_generate(s, &o, &mut m) },
+        CURVETET_ERR_CANCELLED
+    );
+    assert!(m.is_null());
+    assert_eq!(calls.len(), 3);
+    assert!(last_error().contains("cancelled"), "{}", last_error());
+
+    assert_eq!(unsafe { curvetet_generate(s, null(), &mut m) }, CURVETET_OK);
+    let mesh = unsafe { &*m };
+    let g = &mesh.generated;
+    assert_eq!(unsafe { curvetet_mesh_num_tets(m) }, g.mesh.tets.len());
+    assert_eq!(unsafe { curvetet_mesh_num_nodes(m) }, g.mesh.nodes.len());
+    assert_eq!(unsafe { curvetet_mesh_num_boundary_faces(m) }, nt);
+
+    let n = g.mesh.tets.len();
+    let mut gmsh = vec![0u32; 10 * n];
+    let mut vtk = vec![0u32; 10 * n];
+    assert_eq!(
+        unsafe { curvetet_mesh_tets(m, NodeOrderArg(0), gmsh.as_mut_ptr()) },
+        CURVETET_OK
+    );
+    assert_eq!(
+        unsafe { curvetet_mesh_tets(m, NodeOrderArg(1), vtk.as_mut_ptr()) },
+        CURVETET_OK
+    );
+    for k in 0..n {
+        assert_eq!(gmsh[10 * k..10 * k + 8], vtk[10 * k..10 * k + 8]);
+        assert_eq!(
+            (gmsh[10 * k + 8], gmsh[10 * k + 9]),
+            (vtk[10 * k + 9], vtk[10 * k + 8])
+        );
+    }
+    assert_eq!(
+        unsafe { curvetet_mesh_tets(m, NodeOrderArg(2), vtk.as_mut_ptr()) },
+        CURVETET_ERR_INVALID_ARGUMENT
+    );
+    assert!(last_error().contains("order is 2"));
+
+    // Quality: a full struct, then an older/smaller one is refused below v1, and a bigger
+    // one is filled up to this library's size.
+    let mut q = curvetet_quality {
+        struct_size: std::mem::size_of::<curvetet_quality>() as u32,
+        ..Default::default()
+    };
+    assert_eq!(unsafe { curvetet_mesh_quality(m, &mut q) }, CURVETET_OK);
+    assert_eq!(q.num_tets as usize, n);
+    assert_eq!(q.num_invalid, 0);
+    assert!(q.min_scaled_jacobian > 0.0 && q.min_scaled_jacobian_certified > 0.0);
+    q.struct_size = 0;
+    assert_eq!(
+        unsafe { curvetet_mesh_quality(m, &mut q) },
+        CURVETET_ERR_INVALID_ARGUMENT
+    );
+    #[repr(C)]
+    struct Bigger {
+        q: curvetet_quality,
+        more: f64,
+    }
+    let mut b = Bigger {
+        q: curvetet_quality {
+            struct_size: std::mem::size_of::<Bigger>() as u32,
+            ..Default::default()
+        },
+        more: 42.0,
+    };
+    assert_eq!(unsafe { curvetet_mesh_quality(m, &mut b.q) }, CURVETET_OK);
+    assert_eq!(b.q.struct_size as usize, QUALITY_SIZE_V1);
+    assert_eq!(b.more, 42.0);
+    assert_eq!(b.q.num_tets as usize, n);
+
+    let json = unsafe { CStr::from_ptr(curvetet_mesh_report_json(m)) };
+    let v: serde_json::Value = serde_json::from_str(json.to_str().unwrap()).unwrap();
+    assert_eq!(v["report"]["num_tets"].as_u64(), Some(n as u64));
+    // Same pointer on the second call (owned by the mesh).
+    assert_eq!(json.as_ptr(), unsafe { curvetet_mesh_report_json(m) });
+
+    let bad = CString::new("/nonexistent-dir/x.msh").unwrap();
+    assert_eq!(
+        unsafe { curvetet_mesh_write(m, bad.as_ptr()) },
+        CURVETET_ERR_IO
+    );
+    let bad = CString::new("x.unknown").unwrap();
+    assert_eq!(
+        unsafe { curvetet_mesh_write(m, bad.as_ptr()) },
+        CURVETET_ERR_INVALID_ARGUMENT
+    );
+    assert_eq!(
+        unsafe { curvetet_mesh_write_with_flags(m, bad.as_ptr(), 64) },
+        CURVETET_ERR_INVALID_ARGUMENT
+    );
+    assert!(last_error().contains("flag"));
+
+    unsafe { curvetet_mesh_free(m) };
+    unsafe { curvetet_surface_free(s) };
+}

@@ -1,0 +1,309 @@
+//! Closing a small stuck cavity exactly: when a front face cannot be advanced at any
+//! relaxation level and its front component (a closed cavity) is small, search for a
+//! tetrahedralization of the cavity by depth-first search over its own vertices (most
+//! constrained face first, best quality first, every tet checked with the exact validity
+//! test and the certified P2 Jacobian). If none exists without a Steiner point, add the
+//! Chebyshev centre of the cavity's kernel (a small LP) as one.
+//!
+//! The search is complete for the vertex set it is given and bounded by a node budget.
+
+use super::validity::{self, FaceRef, TET_OUT_FACES};
+use super::Mesher;
+use crate::geom::predicates::orient3d;
+use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
+use crate::geom::vec3::*;
+
+/// Largest cavity (front faces) the exact search takes on.
+pub(super) const MAX_CAVITY_FACES: usize = 40;
+/// Search nodes per cavity.
+const NODE_BUDGET: usize = 300;
+/// Id used for the Steiner point during the search.
+const STEINER: u32 = u32::MAX - 2;
+
+struct Search<'s> {
+    pos: &'s dyn Fn(u32) -> P3,
+    /// Front faces around the cavity that are not part of it (never crossed).
+    fixed: Vec<FaceRef>,
+    verts: Vec<u32>,
+    open: Vec<FaceRef>,
+    out: Vec<[u32; 4]>,
+    nodes: usize,
+    curved_ok: &'s dyn Fn([u32; 4], &[P3; 4]) -> bool,
+}
+
+impl Search<'_> {
+    fn valid_apexes(&self, fi: usize, buf: &mut Vec<(f64, u32)>) {
+        buf.clear();
+        let f = self.open[fi].v;
+        let fp = f.map(|v| (self.pos)(v));
+        let mut near: Vec<FaceRef> = Vec::with_capacity(self.open.len() + self.fixed.len());
+        for (k, g) in self.open.iter().enumerate() {
+            if k != fi {
+                near.push(*g);
+            }
+        }
+        near.extend_from_slice(&self.fixed);
+        for &v in &self.verts {
+            if f.contains(&v) {
+                continue;
+            }
+            let p = (self.pos)(v);
+            if orient3d(fp[0], fp[1], fp[2], p) <= 0 {
+                continue;
+            }
+            let t = [f[0], f[1], f[2], v];
+            let tp = [fp[0], fp[1], fp[2], p];
+            if validity::check(t, tp, &near, |i| (self.pos)(i), 0.0).is_none() {
+                continue;
+            }
+            if !(self.curved_ok)(t, &tp) {
+                continue;
+            }
+            let (mn, mx) = dihedral_extremes(&tp);
+            let q = 1.0 - skewness_from_extremes(mn, mx);
+            buf.push((if q.is_nan() { -1.0 } else { q }, v));
+        }
+        buf.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    }
+
+    /// Apply tet (open[fi], v); returns what to undo.
+    fn apply(&mut self, fi: usize, v: u32) -> (FaceRef, Vec<FaceRef>, Vec<[u32; 3]>) {
+        let base = self.open.swap_remove(fi);
+        let t = [base.v[0], base.v[1], base.v[2], v];
+        let mut removed = Vec::new();
+        let mut added = Vec::new();
+        for g in &TET_OUT_FACES[1..] {
+            let nv = [t[g[0]], t[g[1]], t[g[2]]];
+            let k = sorted(nv);
+            if let Some(j) = self.open.iter().position(|o| sorted(o.v) == k) {
+                removed.push(self.open.swap_remove(j));
+            } else {
+                self.open.push(FaceRef {
+                    v: nv,
+                    boundary: false,
+                });
+                added.push(nv);
+            }
+        }
+        self.out.push(t);
+        (base, removed, added)
+    }
+
+    fn undo(&mut self, base: FaceRef, removed: Vec<FaceRef>, added: Vec<[u32; 3]>) {
+        self.out.pop();
+        for a in added {
+            if let Some(j) = self.open.iter().position(|o| o.v == a) {
+                self.open.swap_remove(j);
+            }
+        }
+        self.open.extend(removed);
+        self.open.push(base);
+    }
+
+    fn dfs(&mut self) -> bool {
+        if self.open.is_empty() {
+            return true;
+        }
+        self.nodes += 1;
+        if self.nodes > NODE_BUDGET {
+            return false;
+        }
+        // Most constrained face first.
+        let mut best: Option<(usize, Vec<(f64, u32)>)> = None;
+        let mut buf = Vec::new();
+        for fi in 0..self.open.len() {
+            self.valid_apexes(fi, &mut buf);
+            if buf.is_empty() {
+                return false;
+            }
+            if best.as_ref().map_or(true, |b| buf.len() < b.1.len()) {
+                best = Some((fi, buf.clone()));
+                if buf.len() == 1 {
+                    break;
+                }
+            }
+        }
+        let Some((fi, options)) = best else {
+            return false;
+        };
+        let key = self.open[fi].v;
+        for (_, v) in options {
+            let fi = self.open.iter().position(|o| o.v == key).unwrap_or(fi);
+            let (b, r, a) = self.apply(fi, v);
+            if self.dfs() {
+                return true;
+            }
+            self.undo(b, r, a);
+            if self.nodes > NODE_BUDGET {
+                return false;
+            }
+        }
+        false
+    }
+}
+
+fn sorted(mut v: [u32; 3]) -> [u32; 3] {
+    v.sort_unstable();
+    v
+}
+
+impl Mesher<'_> {
+    /// The front component (closed cavity) containing live face `fid`, if it has at most
+    /// `max` faces.
+    pub(super) fn component(&mut self, fid: u32, max: usize) -> Option<Vec<u32>> {
+        let mut comp = vec![fid];
+        let mut seen = std::collections::HashSet::new();
+        seen.insert(fid);
+        let mut i = 0;
+        let mut ids = Vec::new();
+        while i < comp.len() {
+            let f = self.faces[comp[i] as usize].v;
+            let p = f.map(|v| self.pts[v as usize]);
+            let bb = super::grid::Aabb::of(&p);
+            let faces = &self.faces;
+            self.grid.query(&bb, |k| faces[k as usize].alive, &mut ids);
+            for &k in &ids {
+                if seen.contains(&k) {
+                    continue;
+                }
+                let g = self.faces[k as usize].v;
+                if g.iter().filter(|x| f.contains(x)).count() == 2 {
+                    seen.insert(k);
+                    comp.push(k);
+                    if comp.len() > max {
+                        return None;
+                    }
+                }
+            }
+            i += 1;
+        }
+        Some(comp)
+    }
+
+    /// Try to tetrahedralize the cavity made of live front faces `comp`; on success the
+    /// tets are inserted and true is returned.
+    pub(super) fn fill_cavity(&mut self, comp: &[u32]) -> bool {
+        let mut verts: Vec<u32> = comp
+            .iter()
+            .flat_map(|&f| self.faces[f as usize].v)
+            .collect();
+        verts.sort_unstable();
+        verts.dedup();
+        let open: Vec<FaceRef> = comp
+            .iter()
+            .map(|&f| FaceRef {
+                v: self.faces[f as usize].v,
+                boundary: self.faces[f as usize].btri != u32::MAX,
+            })
+            .collect();
+        // Other live front faces in the cavity's box: never to be crossed.
+        let mut bb = super::grid::Aabb::of(
+            &verts
+                .iter()
+                .map(|&v| self.pts[v as usize])
+                .collect::<Vec<_>>(),
+        );
+        for d in 0..3 {
+            let pad = 1e-9 * (bb.hi[d] - bb.lo[d]).abs().max(1.0);
+            bb.lo[d] -= pad;
+            bb.hi[d] += pad;
+        }
+        let faces = &self.faces;
+        let mut ids = Vec::new();
+        self.grid.query(&bb, |k| faces[k as usize].alive, &mut ids);
+        let fixed: Vec<FaceRef> = ids
+            .iter()
+            .filter(|k| !comp.contains(k))
+            .map(|&k| FaceRef {
+                v: self.faces[k as usize].v,
+                boundary: self.faces[k as usize].btri != u32::MAX,
+            })
+            .collect();
+        // First without, then with one Steiner point.
+        for with_steiner in [false, true] {
+            let steiner = if with_steiner {
+                match self.kernel_point(&open) {
+                    Some(p) => Some(p),
+                    None => break,
+                }
+            } else {
+                None
+            };
+            let pts = &self.pts;
+            let pos = move |i: u32| -> P3 {
+                if i == STEINER {
+                    steiner.unwrap_or([f64::NAN; 3])
+                } else {
+                    pts[i as usize]
+                }
+            };
+            let me = &*self;
+            let curved_ok = |t: [u32; 4], tp: &[P3; 4]| {
+                me.p2_nodes(t, tp).map_or(true, |x| super::curved_valid(&x))
+            };
+            let mut vs = verts.clone();
+            if steiner.is_some() {
+                vs.push(STEINER);
+            }
+            let mut s = Search {
+                pos: &pos,
+                fixed: fixed.clone(),
+                verts: vs,
+                open: open.clone(),
+                out: Vec::new(),
+                nodes: 0,
+                curved_ok: &curved_ok,
+            };
+            if s.dfs() {
+                let tets = s.out;
+                let sid = steiner.map(|p| self.new_point(p));
+                for t in tets {
+                    let t = t.map(|v| if v == STEINER { sid.unwrap_or(v) } else { v });
+                    let base = [t[0], t[1], t[2]];
+                    let Some(&fid) = self.face_map.get(&super::key3(base)) else {
+                        continue;
+                    };
+                    self.insert_tet(t, fid);
+                }
+                return true;
+            }
+        }
+        false
+    }
+
+    /// A point strictly inside every face's inner half-space (the Chebyshev centre of the
+    /// cavity's kernel), if the kernel has an interior.
+    fn kernel_point(&self, open: &[FaceRef]) -> Option<P3> {
+        use microlp::{ComparisonOp, OptimizationDirection, Problem};
+        let mut pr = Problem::new(OptimizationDirection::Maximize);
+        let inf = f64::INFINITY;
+        // Work relative to the first vertex for conditioning.
+        let o = self.pts[open[0].v[0] as usize];
+        let x = pr.add_var(0.0, (-inf, inf));
+        let y = pr.add_var(0.0, (-inf, inf));
+        let z = pr.add_var(0.0, (-inf, inf));
+        let t = pr.add_var(1.0, (0.0, inf));
+        for f in open {
+            let p = f.v.map(|v| sub(self.pts[v as usize], o));
+            let n = normalize(tri_normal(p[0], p[1], p[2]));
+            // n . (q - p0) >= t   (inward normals)
+            pr.add_constraint(
+                [(x, n[0]), (y, n[1]), (z, n[2]), (t, -1.0)],
+                ComparisonOp::Ge,
+                dot(n, p[0]),
+            );
+        }
+        let sol = pr.solve().ok()?.into_solution().ok()?;
+        if sol.var_value(t) <= 0.0 {
+            return None;
+        }
+        let q = add([sol.var_value(x), sol.var_value(y), sol.var_value(z)], o);
+        // Confirm exactly: strictly inside every face.
+        open.iter()
+            .all(|f| {
+                let p = f.v.map(|v| self.pts[v as usize]);
+                orient3d(p[0], p[1], p[2], q) > 0
+            })
+            .then_some(q)
+    }
+}
