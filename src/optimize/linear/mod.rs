@@ -376,8 +376,8 @@ mod tests {
         for v in c.n_surf..pts.len() {
             for _ in 0..20 {
                 let old = pts[v];
-                for d in 0..3 {
-                    pts[v][d] += rng.random_range(-0.09..0.09);
+                for x in pts[v].iter_mut() {
+                    *x += rng.random_range(-0.09..0.09);
                 }
                 if all_positive(&pts, &c.tets) {
                     break;
