@@ -77,6 +77,8 @@ fn main() {
         rounds: env("ROUNDS", d.rounds as f64) as usize,
         move_vertices: env("MV", 1.0) > 0.0,
         max_skewness: env("MAXSKEW", d.max_skewness),
+        max_skewness_rescue: env("MAXSKEWR", d.max_skewness_rescue),
+        rescue_below: env("RESCUE", d.rescue_below),
         barrier_updates: env("BAR", d.barrier_updates as f64) as usize,
         iterations: env("IT", d.iterations as f64) as usize,
     };

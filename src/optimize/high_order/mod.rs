@@ -40,6 +40,12 @@ pub struct HighOrderParams {
     /// Largest corner skewness moving vertices may create (a patch already worse may
     /// not get worse).
     pub max_skewness: f64,
+    /// The larger skewness allowed in a patch whose min J / max J is below
+    /// [`HighOrderParams::rescue_below`]: corner shape traded for curved validity where
+    /// the curved quality is poor.
+    pub max_skewness_rescue: f64,
+    /// See [`HighOrderParams::max_skewness_rescue`].
+    pub rescue_below: f64,
     /// Barrier updates per patch.
     pub barrier_updates: usize,
     /// L-BFGS iterations per barrier.
@@ -54,6 +60,8 @@ impl Default for HighOrderParams {
             rounds: 3,
             move_vertices: true,
             max_skewness: 0.7,
+            max_skewness_rescue: 0.8,
+            rescue_below: 0.5,
             barrier_updates: 3,
             iterations: 10,
         }
@@ -245,7 +253,8 @@ fn evaluate(elems: &[PatchElem], v: &[f64], enough: f64, out: &mut Vec<f64>) -> 
 /// Stage A moves the free mid nodes only (the straight-sided shape is kept); when that
 /// leaves the patch below the threshold and vertices may move, stage B continues from
 /// A's result with the free vertices too, kept only if their corner skewness stays
-/// within [`HighOrderParams::max_skewness`] (or below the patch's previous worst).
+/// within [`HighOrderParams::max_skewness`] ([`HighOrderParams::max_skewness_rescue`]
+/// for a poor patch), or below the patch's previous worst.
 fn optimize_patch(
     mesh: &TetMesh,
     x: &[P3],
@@ -317,7 +326,12 @@ fn optimize_patch(
         run_barrier(&elems, &mut v, h, prm, lb);
         if v != vb {
             let (lo, sk) = evaluate(&elems, &v, prm.threshold, &mut scores);
-            if lo > best_min && sk <= before_skew.max(prm.max_skewness) {
+            let cap = if before_min < prm.rescue_below {
+                prm.max_skewness_rescue
+            } else {
+                prm.max_skewness
+            };
+            if lo > best_min && sk <= before_skew.max(cap) {
                 best = Some((v.clone(), scores.clone()));
             }
         }
@@ -552,6 +566,8 @@ mod stress {
             rounds: env("ROUNDS", d.rounds as f64) as usize,
             move_vertices: env("MV", 1.0) > 0.0,
             max_skewness: env("MAXSKEW", d.max_skewness),
+            max_skewness_rescue: env("MAXSKEWR", d.max_skewness_rescue),
+            rescue_below: env("RESCUE", d.rescue_below),
             barrier_updates: env("BAR", d.barrier_updates as f64) as usize,
             iterations: env("IT", d.iterations as f64) as usize,
         };

@@ -5,7 +5,7 @@
 //! [−1, −0.5] by its scaled-Jacobian lower bound (so operations may improve it but never
 //! create one); a non-positive tet scores −∞.
 
-use crate::geom::bezier::{certify, jacobian_bounds};
+use crate::geom::bezier::{certify, jacobian_bezier, jacobian_bounds};
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG};
 use crate::geom::vec3::P3;
@@ -40,6 +40,15 @@ impl ElementQuality {
                     sj.clamp(-1.0, 0.0)
                 };
                 return -1.0 + 0.5 * (1.0 + sj);
+            }
+            if curved && nb == 4 {
+                // No interior vertex: the high-order stage can move few nodes of this
+                // tet, so its curved shape counts here (unrefined Bernstein ratio).
+                let b = jacobian_bezier(&x);
+                let (lo, hi) = b
+                    .iter()
+                    .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+                return (1.0 - s).min(lo / hi);
             }
         }
         1.0 - s
