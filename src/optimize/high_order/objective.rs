@@ -93,6 +93,30 @@ pub(super) fn score(x: &[P3; 10], enough: f64) -> f64 {
     }
 }
 
+/// ln x for a positive normal `x`, branch-free (absolute error below 1e-13): x = 2^e m with
+/// m in [√½, √2), ln m = 2 atanh((m − 1)/(m + 1)) by its series to the 15th power.
+/// Several times faster than the libm call in the objective's inner loop, where it is
+/// evaluated twenty times per element; tested against `f64::ln`.
+#[inline]
+fn ln_pos(x: f64) -> f64 {
+    const LN2: f64 = std::f64::consts::LN_2;
+    let bits = x.to_bits();
+    let mut e = ((bits >> 52) & 0x7ff) as i64 - 1023;
+    let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    // Branch-free m > √2 ⇒ m /= 2, e += 1.
+    let big = (m > std::f64::consts::SQRT_2) as i64;
+    m *= 1.0 - 0.5 * big as f64;
+    e += big;
+    let s = (m - 1.0) / (m + 1.0);
+    let z = s * s;
+    let p = 1.0
+        + z * (1.0 / 3.0
+            + z * (1.0 / 5.0
+                + z * (1.0 / 7.0
+                    + z * (1.0 / 9.0 + z * (1.0 / 11.0 + z * (1.0 / 13.0 + z * (1.0 / 15.0)))))));
+    e as f64 * LN2 + 2.0 * s * p
+}
+
 /// The normalization N(μ) and its derivative.
 #[inline]
 fn norm_of_mean(mu: f64, delta: f64) -> (f64, f64) {
@@ -178,19 +202,28 @@ impl Objective<'_> {
                 return f64::INFINITY;
             }
             let inv = 1.0 / nrm;
+            let mut m = [0.0; 20];
+            let mut lo = f64::INFINITY;
+            for s in 0..20 {
+                m[s] = b[s] * inv;
+                lo = lo.min(m[s]);
+            }
+            if lo.is_nan() || lo <= eps {
+                return f64::INFINITY;
+            }
+            // Branch-free from here (vectorizable).
             let mut df = [0.0; 20];
             let mut dm_sum = 0.0;
+            let mut part = 0.0;
             for s in 0..20 {
-                let m = b[s] * inv;
-                if m.is_nan() || m <= eps {
-                    return f64::INFINITY;
-                }
-                let l = (m - eps).ln() - lden;
-                total += (m - 1.0) * (m - 1.0) + l * l;
-                let d = 2.0 * ((m - 1.0) + l / (m - eps));
+                let r = m[s] - eps;
+                let l = ln_pos(r) - lden;
+                part += (m[s] - 1.0) * (m[s] - 1.0) + l * l;
+                let d = 2.0 * ((m[s] - 1.0) + l / r);
                 df[s] = d;
-                dm_sum += d * m;
+                dm_sum += d * m[s];
             }
+            total += part;
             // m_s = b_s / N(mean): ∂F/∂b_r = f'(m_r)/N − N' Σ_s f'(m_s) m_s / (20 N).
             let corr = dm_sum * dn / 20.0;
             let mut gb = [0.0; 20];
@@ -226,6 +259,20 @@ impl Objective<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_ln_matches_ln() {
+        let mut x = 1e-300;
+        while x < 1e300 {
+            for f in [1.0, 1.1, 1.3, 1.414, 1.4143, 1.7, 1.99] {
+                let v = x * f;
+                let (a, b) = (ln_pos(v), v.ln());
+                let tol = 1e-13 + 4.0 * f64::EPSILON * b.abs();
+                assert!((a - b).abs() <= tol, "{v}: {a} vs {b}");
+            }
+            x *= 7.3;
+        }
+    }
 
     #[test]
     fn gradient_matches_finite_differences() {
