@@ -73,6 +73,7 @@ fn main() {
     let d = HighOrderParams::default();
     let hp = HighOrderParams {
         threshold: env("TH", d.threshold),
+        reach: env("REACH", d.reach),
         layers: env("LAYERS", d.layers as f64) as usize,
         rounds: env("ROUNDS", d.rounds as f64) as usize,
         move_vertices: env("MV", 1.0) > 0.0,

@@ -31,6 +31,10 @@ use rayon::prelude::*;
 pub struct HighOrderParams {
     /// Elements with certified min J / max J below this seed patches.
     pub threshold: f64,
+    /// Each round aims at most this far above the current worst element (the round's
+    /// threshold is min(threshold, max(worst, 0) + reach)): effort goes to the worst
+    /// first, and to every invalid element while some are left.
+    pub reach: f64,
     /// Vertex-neighbour rings around a seed in its patch (round r uses `layers + r`).
     pub layers: usize,
     /// Rounds of (seed, patch, optimize).
@@ -56,8 +60,9 @@ impl Default for HighOrderParams {
     fn default() -> Self {
         HighOrderParams {
             threshold: 0.85,
+            reach: 0.2,
             layers: 1,
-            rounds: 3,
+            rounds: 5,
             move_vertices: true,
             max_skewness: 0.7,
             max_skewness_rescue: 0.8,
@@ -124,6 +129,12 @@ pub fn optimize_high_order(
     let adj = NodeElems::new(mesh);
     let mut marks = Marks::new(ne, mesh.nodes.len());
     for round in 0..prm.rounds {
+        let worst = sj.iter().copied().fold(f64::INFINITY, f64::min);
+        let rp = HighOrderParams {
+            threshold: prm.threshold.min(worst.max(0.0) + prm.reach),
+            ..prm.clone()
+        };
+        let prm = &rp;
         let mut seeds: Vec<u32> = (0..ne as u32)
             .filter(|&t| sj[t as usize] < prm.threshold)
             .collect();
@@ -198,6 +209,15 @@ pub fn optimize_high_order(
         if improved_round == 0 {
             break;
         }
+    }
+    // Exact scores where a round stored a cheaper lower bound below the threshold.
+    let exact: Vec<(usize, f64)> = (0..ne)
+        .into_par_iter()
+        .filter(|&t| sj[t] < prm.threshold && sj[t] != sj_start[t])
+        .map(|t| (t, element_score(mesh, t, prm.threshold)))
+        .collect();
+    for (t, v) in exact {
+        sj[t] = v;
     }
     let (m1, i1, b1) = census(&sj);
     st.min_scaled_jacobian[1] = if ne == 0 { 1.0 } else { m1 };
@@ -595,6 +615,7 @@ mod stress {
         let d = HighOrderParams::default();
         let hp = HighOrderParams {
             threshold: env("TH", d.threshold),
+            reach: env("REACH", d.reach),
             layers: env("LAYERS", d.layers as f64) as usize,
             rounds: env("ROUNDS", d.rounds as f64) as usize,
             move_vertices: env("MV", 1.0) > 0.0,
