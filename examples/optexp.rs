@@ -87,6 +87,7 @@ fn main() {
     let th = t.elapsed().as_secs_f64();
     println!("HO wall {th:.3}s cpu {:.3}s", cpu() - c);
     worst(&mesh, surf.nodes().len(), 8);
+    worst_skew(&mesh, surf.nodes().len(), 12);
     let r = QualityReport::of(&mesh);
     println!("after HO {th:.3}s: minSJ {:.4} cert {:.4} maxskew {:.4} dih {:.2}..{:.2} invalid {} {hs:?}", r.quality.scaled_jacobian.min, r.quality.scaled_jacobian_certified.min, r.quality.skewness.max, r.quality.min_dihedral.min, r.quality.max_dihedral.max, r.num_invalid);
 }
@@ -127,5 +128,41 @@ pub fn worst(mesh: &curvetet::TetMesh, n_surf: usize, k: usize) {
             .count();
         let q = tet_quality(&tet_nodes(mesh, t));
         println!("  tet {t}: sj {s:.4} bverts {nb} bmids {nbm} bfaces {faces} skew {:.3} dih {:.1}..{:.1}", q.skewness, q.min_dihedral, q.max_dihedral);
+    }
+}
+
+#[allow(dead_code)]
+pub fn worst_skew(mesh: &curvetet::TetMesh, n_surf: usize, k: usize) {
+    use curvetet::geom::quality::tet_quality;
+    use curvetet::mesh::quality::tet_nodes;
+    let mut v: Vec<(f64, usize)> = (0..mesh.tets.len())
+        .map(|t| (tet_quality(&tet_nodes(mesh, t)).skewness, t))
+        .collect();
+    v.sort_by(|a, b| b.0.total_cmp(&a.0));
+    let bset: std::collections::HashSet<[u32; 3]> = mesh
+        .boundary
+        .iter()
+        .map(|b| {
+            let mut k = [b[0], b[1], b[2]];
+            k.sort();
+            k
+        })
+        .collect();
+    for &(s, t) in v.iter().take(k) {
+        let e = mesh.tets[t];
+        let nb = e[..4].iter().filter(|&&x| (x as usize) < n_surf).count();
+        let faces = [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]]
+            .iter()
+            .filter(|f| {
+                let mut k = [e[f[0]], e[f[1]], e[f[2]]];
+                k.sort();
+                bset.contains(&k)
+            })
+            .count();
+        let q = tet_quality(&tet_nodes(mesh, t));
+        println!(
+            "  skew tet {t}: skew {s:.3} bverts {nb} bfaces {faces} sj {:.3} dih {:.1}..{:.1}",
+            q.scaled_jacobian_certified, q.min_dihedral, q.max_dihedral
+        );
     }
 }

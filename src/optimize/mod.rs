@@ -1,8 +1,9 @@
 //! Mesh improvement after the advancing front, in two stages:
 //!
 //! 1. [`linear`]: the straight-sided core is improved by flips (2-3, edge removal 3-2 /
-//!    4-4 / n-to-(2n-4)), contraction of edges with an interior end point, and smoothing
-//!    of interior vertices, worst element first. Boundary vertices never move and boundary
+//!    4-4 / n-to-(2n-4)), contraction of edges with an interior end point, smoothing of
+//!    interior vertices and insertion of interior vertices on interior edges, worst
+//!    element first. Boundary vertices never move and boundary
 //!    faces never change; every operation keeps all tets positive (exact `orient3d`) and
 //!    every tet touching a curved boundary edge certified valid.
 //! 2. [`high_order`]: on the assembled P2 mesh, patches around the elements of lowest

@@ -2,13 +2,15 @@
 //!
 //! Worst element first: every tet whose quality (1 − equiangular skewness, see
 //! [`quality`]) is below the goal is attacked in turn by edge removal on its edges, 2-3
-//! flips on its faces, smoothing of its interior vertices and contraction of its edges
-//! that have an interior end point; an operation is kept only when it raises the minimum
-//! quality of the tets it touches. Passes repeat while something improves. Sequential and
+//! flips on its faces, smoothing of its interior vertices, contraction of its edges
+//! that have an interior end point, and insertion of a vertex on one of its interior
+//! edges (longest first); an operation is kept only when it raises the minimum quality
+//! of the tets it touches. Passes repeat while something improves. Sequential and
 //! deterministic.
 
 mod contract;
 mod flips;
+mod insert;
 mod mesh;
 mod quality;
 mod smooth;
@@ -18,6 +20,7 @@ use crate::geom::vec3::P3;
 use crate::optimize::Boundary;
 use contract::{contract, ContractScratch};
 use flips::{flip23, remove_edge, FlipScratch};
+use insert::{split_edge, InsertScratch};
 use mesh::LinMesh;
 pub use quality::ElementQuality;
 use smooth::{smooth_vertex, SmoothParams, SmoothScratch};
@@ -62,6 +65,8 @@ pub struct LinearStats {
     pub contractions: usize,
     /// Vertex smoothings that moved a vertex.
     pub smoothings: usize,
+    /// Interior vertices inserted (edge splits kept).
+    pub insertions: usize,
 }
 
 /// Worst quality and the count of tets below `goal`.
@@ -84,6 +89,7 @@ struct Scratch {
     contract: ContractScratch,
     smooth: SmoothScratch,
     smooth_prm: SmoothParams,
+    insert: InsertScratch,
 }
 
 /// Improve the straight-sided tets `tets` on `pts` (surface nodes first, as the front
@@ -108,6 +114,7 @@ pub fn improve_linear(
         contract: ContractScratch::default(),
         smooth: SmoothScratch::default(),
         smooth_prm: SmoothParams::default(),
+        insert: InsertScratch::default(),
     };
     let mut order: Vec<(f64, u32, [u32; 4])> = Vec::new();
     for _ in 0..prm.max_passes {
@@ -170,6 +177,19 @@ fn improve_tet(m: &mut LinMesh, t: u32, eps: f64, sc: &mut Scratch, st: &mut Lin
         let (a, b) = (tv[i], tv[j]);
         if contract(m, a, b, eps, &mut sc.contract) || contract(m, b, a, eps, &mut sc.contract) {
             st.contractions += 1;
+            return true;
+        }
+    }
+    // Longest edges first.
+    let mut edges = TET10_EDGES.map(|[i, j]| {
+        let (a, b) = (tv[i], tv[j]);
+        let l = crate::geom::vec3::dist2(m.pts[a as usize], m.pts[b as usize]);
+        (l, a, b)
+    });
+    edges.sort_by(|x, y| y.0.total_cmp(&x.0).then((x.1, x.2).cmp(&(y.1, y.2))));
+    for (_, a, b) in edges {
+        if split_edge(m, a, b, eps, &sc.smooth_prm, &mut sc.insert, &mut sc.smooth) {
+            st.insertions += 1;
             return true;
         }
     }
