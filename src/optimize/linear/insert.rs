@@ -46,6 +46,7 @@ pub(super) fn split_edge(
     m.pts.push(p);
     m.vt.push(Vec::new());
     m.dirty.push(true);
+    m.changed.push(m.clock);
     let mut ok = true;
     for &t in &s.ts {
         let (u, v) = opposite_edge(m.tets[t as usize], a, b);
@@ -59,6 +60,7 @@ pub(super) fn split_edge(
         m.pts.pop();
         m.vt.pop();
         m.dirty.pop();
+        m.changed.pop();
         return false;
     }
     for i in 0..s.ts.len() {

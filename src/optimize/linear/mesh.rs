@@ -24,6 +24,10 @@ pub(super) struct LinMesh<'a> {
     pub eq: ElementQuality,
     /// Per point: its star changed since it was last smoothed to a standstill.
     pub dirty: Vec<bool>,
+    /// Per point: the [`LinMesh::clock`] value of the last change in its star.
+    pub changed: Vec<u64>,
+    /// Counts changes (tets added or removed, vertices moved).
+    pub clock: u64,
     /// Deleted slots, reused by [`LinMesh::add`] (last freed first).
     free: Vec<u32>,
 }
@@ -45,9 +49,12 @@ impl<'a> LinMesh<'a> {
             bnd,
             eq,
             dirty: vec![true; 0],
+            changed: Vec::new(),
+            clock: 1,
             free: Vec::new(),
         };
         m.dirty = vec![true; m.pts.len()];
+        m.changed = vec![1; m.pts.len()];
         for i in 0..m.tets.len() {
             m.q[i] = m.quality(m.tets[i]);
         }
@@ -80,6 +87,7 @@ impl<'a> LinMesh<'a> {
 
     /// Insert a tet with known quality; returns its slot.
     pub fn add(&mut self, v: [u32; 4], q: f64) -> u32 {
+        self.clock += 1;
         let t = if let Some(t) = self.free.pop() {
             self.tets[t as usize] = v;
             self.q[t as usize] = q;
@@ -92,15 +100,18 @@ impl<'a> LinMesh<'a> {
         for &x in &v {
             self.vt[x as usize].push(t);
             self.dirty[x as usize] = true;
+            self.changed[x as usize] = self.clock;
         }
         t
     }
 
     /// Delete tet `t`.
     pub fn remove(&mut self, t: u32) {
+        self.clock += 1;
         let v = self.tets[t as usize];
         for &x in &v {
             self.dirty[x as usize] = true;
+            self.changed[x as usize] = self.clock;
             let s = &mut self.vt[x as usize];
             if let Some(i) = s.iter().position(|&y| y == t) {
                 s.swap_remove(i);
@@ -113,10 +124,12 @@ impl<'a> LinMesh<'a> {
 
     /// Mark every corner of the star of `v` dirty (after `v` moved).
     pub fn touch_star(&mut self, v: u32) {
+        self.clock += 1;
         for i in 0..self.vt[v as usize].len() {
             let t = self.vt[v as usize][i];
             for x in self.tets[t as usize] {
                 self.dirty[x as usize] = true;
+                self.changed[x as usize] = self.clock;
             }
         }
     }

@@ -117,6 +117,9 @@ pub fn improve_linear(
         insert: InsertScratch::default(),
     };
     let mut order: Vec<(f64, u32, [u32; 4])> = Vec::new();
+    // Clock at which each tet slot last resisted every operation (0: never); it is not
+    // tried again until something in its corners' stars changes.
+    let mut failed: Vec<u64> = Vec::new();
     for _ in 0..prm.max_passes {
         st.passes += 1;
         order.clear();
@@ -131,8 +134,21 @@ pub fn improve_linear(
             if m.tets[t as usize] != tv || m.q[t as usize] >= goal {
                 continue;
             }
+            let ti = t as usize;
+            if ti < failed.len()
+                && failed[ti] != 0
+                && tv.iter().all(|&v| m.changed[v as usize] < failed[ti])
+            {
+                continue;
+            }
             if improve_tet(&mut m, t, prm.eps, &mut sc, &mut st) {
                 changed += 1;
+            } else if m.tets[ti] == tv {
+                if failed.len() <= ti {
+                    failed.resize(ti + 1, 0);
+                }
+                m.clock += 1;
+                failed[ti] = m.clock;
             }
         }
         if changed == 0 {

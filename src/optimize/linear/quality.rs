@@ -5,7 +5,7 @@
 //! [−1, −0.5] by its scaled-Jacobian lower bound (so operations may improve it but never
 //! create one); a non-positive tet scores −∞.
 
-use crate::geom::bezier::{certify, jacobian_bezier, jacobian_bounds};
+use crate::geom::bezier::{certify, jacobian_bounds, LinearJacobian};
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG};
 use crate::geom::vec3::P3;
@@ -32,7 +32,18 @@ impl ElementQuality {
         let nb = v.iter().filter(|&&x| bnd.is_fixed(x)).count();
         if nb >= 2 {
             let (x, curved) = bnd.tet10(pts, v, c);
-            if curved && !certify(&x).is_valid() {
+            if !curved {
+                return 1.0 - s;
+            }
+            // The Bernstein coefficients settle almost every tet at once (certify would
+            // compute the same ones first); only the undecided go through `certify`.
+            let lj = LinearJacobian::new(&x);
+            let b = lj.bezier();
+            let (blo, bhi) = b
+                .iter()
+                .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+            let valid = (blo > lj.rounding_margin() && blo.is_finite()) || certify(&x).is_valid();
+            if !valid {
                 let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
                 let sj = if sj.is_nan() {
                     -1.0
@@ -41,14 +52,10 @@ impl ElementQuality {
                 };
                 return -1.0 + 0.5 * (1.0 + sj);
             }
-            if curved && nb == 4 {
+            if nb == 4 {
                 // No interior vertex: the high-order stage can move few nodes of this
                 // tet, so its curved shape counts here (unrefined Bernstein ratio).
-                let b = jacobian_bezier(&x);
-                let (lo, hi) = b
-                    .iter()
-                    .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
-                return (1.0 - s).min(lo / hi);
+                return (1.0 - s).min(blo / bhi);
             }
         }
         1.0 - s
