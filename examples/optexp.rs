@@ -75,6 +75,7 @@ fn main() {
         threshold: env("TH", d.threshold),
         reach: env("REACH", d.reach),
         layers: env("LAYERS", d.layers as f64) as usize,
+        max_layers: env("MAXLAYERS", d.max_layers as f64) as usize,
         rounds: env("ROUNDS", d.rounds as f64) as usize,
         move_vertices: env("MV", 1.0) > 0.0,
         max_skewness: env("MAXSKEW", d.max_skewness),

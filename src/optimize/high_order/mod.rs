@@ -35,8 +35,11 @@ pub struct HighOrderParams {
     /// threshold is min(threshold, max(worst, 0) + reach)): effort goes to the worst
     /// first, and to every invalid element while some are left.
     pub reach: f64,
-    /// Vertex-neighbour rings around a seed in its patch (round r uses `layers + r`).
+    /// Vertex-neighbour rings around a seed in its patch (round r uses
+    /// `min(layers + r, max_layers)`).
     pub layers: usize,
+    /// See [`HighOrderParams::layers`].
+    pub max_layers: usize,
     /// Rounds of (seed, patch, optimize).
     pub rounds: usize,
     /// Let interior vertices move too (their edges' mid nodes follow them).
@@ -62,6 +65,7 @@ impl Default for HighOrderParams {
             threshold: 0.85,
             reach: 0.2,
             layers: 1,
+            max_layers: 2,
             rounds: 5,
             move_vertices: true,
             max_skewness: 0.7,
@@ -155,7 +159,7 @@ pub fn optimize_high_order(
                 &adj,
                 bnd.n_surf,
                 s,
-                prm.layers + round,
+                (prm.layers + round).min(prm.max_layers.max(prm.layers)),
                 prm.move_vertices,
                 &mut marks,
             );
@@ -617,6 +621,7 @@ mod stress {
             threshold: env("TH", d.threshold),
             reach: env("REACH", d.reach),
             layers: env("LAYERS", d.layers as f64) as usize,
+            max_layers: env("MAXLAYERS", d.max_layers as f64) as usize,
             rounds: env("ROUNDS", d.rounds as f64) as usize,
             move_vertices: env("MV", 1.0) > 0.0,
             max_skewness: env("MAXSKEW", d.max_skewness),
