@@ -592,6 +592,30 @@ impl<'a> Mesher<'a> {
                 dist_a: r.distance.sqrt(),
             });
         }
+        // The vertices across the face's edges (the neighbours' apexes) are always
+        // candidates, however far: they are how a wedge closes, and with mixed sizes a
+        // large neighbour's apex can lie outside the search radius.
+        for k in 0..3 {
+            let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) else {
+                continue;
+            };
+            let gv = self.faces[g as usize].v;
+            let Some(&id) = gv.iter().find(|x| !f.v.contains(x)) else {
+                continue;
+            };
+            if self.cands.iter().any(|c| c.id == id) {
+                continue;
+            }
+            let p = self.pts[id as usize];
+            if orient3d(fp[0], fp[1], fp[2], p) > 0 {
+                self.cands.push(Cand {
+                    id,
+                    p,
+                    q: 0.0,
+                    dist_a: dist(p, a),
+                });
+            }
+        }
         // New points: the ideal one, and lower ones when relaxing.
         let heights: &[f64] = match level {
             0 => &[1.0],

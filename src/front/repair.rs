@@ -8,6 +8,9 @@ use super::Mesher;
 use crate::geom::vec3::*;
 use crate::Result;
 
+/// Repairs allowed around one place before the front gives up there.
+const MAX_REPAIRS_PER_REGION: u32 = 12;
+
 impl Mesher<'_> {
     /// Delete the tets around stuck front face `fid` and requeue the faces nearby.
     pub(super) fn repair(&mut self, fid: u32) -> Result<()> {
@@ -25,8 +28,13 @@ impl Mesher<'_> {
             *e += 1;
             *e
         };
+        if count > MAX_REPAIRS_PER_REGION {
+            return Err(self.stuck_error(fid, "repeated local remeshing did not help"));
+        }
+        // The ring grows with each repair here, but stays local: a few element sizes.
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let radius = lf * (0.75 + 0.5 * count as f64);
+        let local = lf.min(self.size.at(c));
+        let radius = local * (0.75 + 0.5 * count.min(4) as f64);
         let fv = self.faces[fid as usize].v;
         let r2 = radius * radius;
         let mut victims = Vec::new();

@@ -53,6 +53,9 @@ pub struct FaceRef {
 thread_local! {
 /// Debug: why the last check failed.
 pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
+thread_local! {
+    static OLD_PROX: f64 = std::env::var("CURVETET_OLD_PROX").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
+}
 fn why(s: String) {
     WHY.with(|w| *w.borrow_mut() = s);
 }
@@ -99,7 +102,13 @@ pub fn check(
         let in_t = |id: u32| t.iter().position(|&x| x == id);
         let loc = [in_t(fv[0]), in_t(fv[1]), in_t(fv[2])];
         let shared = loc.iter().filter(|x| x.is_some()).count();
-        if shared == 0 && min_d2 > 0.0 && t[3] == NEW_POINT {
+        let old_scale = if t[3] == NEW_POINT {
+            1.0
+        } else {
+            OLD_PROX.with(|o| *o)
+        };
+        if shared == 0 && min_d2 > 0.0 && old_scale > 0.0 {
+            let min_d2 = min_d2 * old_scale * old_scale;
             // Proximity: an unrelated front face must not come close to T's apex, nor
             // its vertices close to T's new faces (a narrow gap would be left).
             if point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2 {
