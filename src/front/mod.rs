@@ -54,6 +54,9 @@ pub struct FrontStats {
     pub deleted: u64,
     /// Stuck cavities closed by the exact search.
     pub cavities: u64,
+    /// Tets accepted as a last resort with a non-positive P2 Jacobian (linear-valid, with
+    /// a free mid node), left for the high-order optimizer to untangle.
+    pub p2_invalid: u64,
 }
 
 #[derive(Clone, Copy)]
@@ -96,13 +99,13 @@ struct Cand {
 
 const NEW: u32 = u32::MAX;
 thread_local! { pub static WHYSTAT: std::cell::RefCell<std::collections::BTreeMap<String, u64>> = const { std::cell::RefCell::new(std::collections::BTreeMap::new()) }; }
-thread_local! { pub static NEARSTAT: std::cell::RefCell<[[u64;3];3]> = const { std::cell::RefCell::new([[0;3];3]) }; }
+thread_local! { pub static NEARSTAT: std::cell::RefCell<[[u64;3];4]> = const { std::cell::RefCell::new([[0;3];4]) }; }
 thread_local! { static LEVEL: std::cell::RefCell<u8> = const { std::cell::RefCell::new(0) }; }
 /// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
 /// thinner one could only be closed by a flat tet with a curved face, which is invalid
 /// on concave boundaries, and boundary faces can never be remeshed.
 const MIN_BOUNDARY_GAP_DEG: f64 = 5.0;
-thread_local! { pub static FAILS: std::cell::RefCell<[[u64;4];3]> = const { std::cell::RefCell::new([[0;4];3]) }; }
+thread_local! { pub static FAILS: std::cell::RefCell<[[u64;4];4]> = const { std::cell::RefCell::new([[0;4];4]) }; }
 
 #[inline]
 fn key3(v: [u32; 3]) -> [u32; 3] {
@@ -435,6 +438,11 @@ impl<'a> Mesher<'a> {
                     continue;
                 }
             }
+            // ...else, where remeshing has not helped, accept a tet the optimizer must
+            // untangle...
+            if self.repair_count(fid) >= 4 && self.advance(fid, 3) {
+                continue;
+            }
             // ...else remesh around it.
             if self.stats.repairs >= max_repairs {
                 return Err(self.stuck_error(fid, "repair limit reached"));
@@ -764,14 +772,31 @@ impl<'a> Mesher<'a> {
                 FAILS.with(|f| f.borrow_mut()[level as usize][2] += 1);
                 continue;
             }
+            let mut p2_invalid = false;
             if let Some(x) = self.p2_nodes(t, &tp) {
                 if !curved_valid(&x) {
-                    FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
-                    continue;
+                    // Last resort (level 3): a linear-valid tet whose P2 Jacobian is not
+                    // positive, if it has a free mid node the optimizer can move.
+                    let free_edge = TET10_EDGES.iter().any(|[i, j]| {
+                        let (a, b) = (t[*i], t[*j]);
+                        !((a as usize) < self.n_surf
+                            && (b as usize) < self.n_surf
+                            && self.bedge_mid.contains_key(&(a.min(b), a.max(b))))
+                    });
+                    if level < 3 || !free_edge {
+                        FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
+                        continue;
+                    }
+                    p2_invalid = true;
                 }
             }
             // Look ahead: every thin wedge T leaves must be closable by a valid tet.
-            let closable = verdict.closings[..verdict.num_closings].iter().all(|c| {
+            // (Against boundary faces at every level: those wedges can never be reopened.)
+            let closable = (0..verdict.num_closings).all(|i| {
+                if level >= 2 && !verdict.closing_on_boundary[i] {
+                    return true;
+                }
+                let c = verdict.closings[i];
                 let ct = c.map(|v| {
                     if v == validity::NEW_POINT {
                         cd.p
@@ -780,11 +805,14 @@ impl<'a> Mesher<'a> {
                     }
                 });
                 orient3d(ct[0], ct[1], ct[2], ct[3]) > 0
-                    && self.p2_nodes(*c, &ct).map_or(true, |x| curved_valid(&x))
+                    && self.p2_nodes(c, &ct).map_or(true, |x| curved_valid(&x))
             });
-            if !closable && level < 2 {
+            if !closable && level < 3 {
                 FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
                 continue;
+            }
+            if p2_invalid {
+                self.stats.p2_invalid += 1;
             }
             chosen = Some(*cd);
             break;
@@ -853,6 +881,7 @@ impl<'a> Mesher<'a> {
         if let Ok(tr) = std::env::var("CURVETET_TRACE") {
             let set: Vec<u32> = tr.split(',').filter_map(|x| x.parse().ok()).collect();
             if t.iter().filter(|x| set.contains(x)).count() >= 3 {
+                eprintln!("TRACE pts {:?}", t.map(|v| self.pts[v as usize]));
                 eprintln!(
                     "TRACE tet {:?} base {:?} level {}",
                     t,

@@ -33,6 +33,8 @@ pub struct Verdict {
     pub closings: [[u32; 4]; 6],
     /// Number of entries in `closings`.
     pub num_closings: usize,
+    /// Whether each closing's front face is a boundary face.
+    pub closing_on_boundary: [bool; 6],
 }
 
 /// Id the caller gives a candidate's apex when it is a new point.
@@ -92,6 +94,7 @@ pub fn check(
     let mut min_gap_b = 360.0f64;
     let mut closings = [[0u32; 4]; 6];
     let mut num_closings = 0;
+    let mut closing_on_boundary = [false; 6];
     for f in near {
         let fv = f.v;
         let fp = [pos(fv[0]), pos(fv[1]), pos(fv[2])];
@@ -159,6 +162,7 @@ pub fn check(
             let is_base_face = k != 3 && e0 != 3 && e1 != 3;
             if g < LOOKAHEAD_GAP_DEG && !is_base_face && num_closings < closings.len() {
                 closings[num_closings] = [fv[0], fv[1], fv[2], t[k]];
+                closing_on_boundary[num_closings] = f.boundary;
                 num_closings += 1;
             }
             if f.boundary {
@@ -207,6 +211,7 @@ pub fn check(
         min_gap_boundary_deg: min_gap_b,
         closings,
         num_closings,
+        closing_on_boundary,
     })
 }
 
