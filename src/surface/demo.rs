@@ -78,6 +78,83 @@ pub fn torus_resolution(n_tris: usize, big_r: f64, r: f64) -> (usize, usize) {
     (nu, nv)
 }
 
+/// A closed P2 icosphere of radius 1: `20 * 4^level` triangles, mid nodes on the sphere.
+pub fn icosphere(level: u32) -> (Vec<P3>, Vec<[u32; 6]>) {
+    use std::collections::HashMap;
+    let g = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut v: Vec<[f64; 3]> = vec![
+        [-1.0, g, 0.0],
+        [1.0, g, 0.0],
+        [-1.0, -g, 0.0],
+        [1.0, -g, 0.0],
+        [0.0, -1.0, g],
+        [0.0, 1.0, g],
+        [0.0, -1.0, -g],
+        [0.0, 1.0, -g],
+        [g, 0.0, -1.0],
+        [g, 0.0, 1.0],
+        [-g, 0.0, -1.0],
+        [-g, 0.0, 1.0],
+    ];
+    let mut f: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let unit = |p: [f64; 3]| {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        [p[0] / n, p[1] / n, p[2] / n]
+    };
+    for p in v.iter_mut() {
+        *p = unit(*p);
+    }
+    let midpoint = |v: &mut Vec<[f64; 3]>, cache: &mut HashMap<(u32, u32), u32>, a: u32, b: u32| {
+        let key = (a.min(b), a.max(b));
+        *cache.entry(key).or_insert_with(|| {
+            let (p, q) = (v[a as usize], v[b as usize]);
+            v.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+            v.len() as u32 - 1
+        })
+    };
+    for _ in 0..level {
+        let mut cache = HashMap::new();
+        let mut nf = Vec::with_capacity(4 * f.len());
+        for t in &f {
+            let a = midpoint(&mut v, &mut cache, t[0], t[1]);
+            let b = midpoint(&mut v, &mut cache, t[1], t[2]);
+            let c = midpoint(&mut v, &mut cache, t[2], t[0]);
+            nf.extend([[t[0], a, c], [t[1], b, a], [t[2], c, b], [a, b, c]]);
+        }
+        f = nf;
+    }
+    let mut cache = HashMap::new();
+    let mut tris = Vec::with_capacity(f.len());
+    for t in &f {
+        let a = midpoint(&mut v, &mut cache, t[0], t[1]);
+        let b = midpoint(&mut v, &mut cache, t[1], t[2]);
+        let c = midpoint(&mut v, &mut cache, t[2], t[0]);
+        tris.push([t[0], t[1], t[2], a, b, c]);
+    }
+    (v, tris)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
