@@ -55,16 +55,6 @@ pub struct FaceRef {
     pub boundary: bool,
 }
 
-thread_local! {
-/// Debug: why the last check failed.
-pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
-thread_local! {
-    static OLD_PROX: f64 = std::env::var("CURVETET_OLD_PROX").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-}
-fn why(s: String) {
-    WHY.with(|w| *w.borrow_mut() = s);
-}
-
 /// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
 /// front, t[3] the apex) against the front faces `near` (excluding the base face).
 /// Returns `None` on any conflict. `min_dist` > 0 also rejects a new point (apex id
@@ -86,7 +76,6 @@ pub fn check(
         .map(|&(i, j)| dist2(tp[i], tp[j]))
         .fold(0.0, f64::max);
     if tet_det(tp[0], tp[1], tp[2], tp[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt() {
-        why("numerically degenerate".into());
         return None;
     }
     let tb = Aabb::of(&tp);
@@ -118,23 +107,20 @@ pub fn check(
         let in_t = |id: u32| t.iter().position(|&x| x == id);
         let loc = [in_t(fv[0]), in_t(fv[1]), in_t(fv[2])];
         let shared = loc.iter().filter(|x| x.is_some()).count();
-        let old_scale = if t[3] == NEW_POINT {
-            1.0
-        } else {
-            OLD_PROX.with(|o| *o)
-        };
-        if shared == 0 && min_d2 > 0.0 && old_scale > 0.0 {
-            let min_d2 = min_d2 * old_scale * old_scale;
+        if shared == 0 && min_d2 > 0.0 {
             // Proximity: an unrelated front face must not come close to T's apex, nor
             // its vertices close to T's new faces (a narrow gap would be left).
-            if point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2 {
-                why(format!("apex too close to {:?}", fv));
+            // (Box distances first: most faces are ruled out without the exact distance.)
+            if fb.dist2(tp[3]) < min_d2 && point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2
+            {
                 return None;
             }
             for q in fp {
+                if tb.dist2(q) >= min_d2 {
+                    continue;
+                }
                 for g in &TET_OUT_FACES[1..] {
                     if point_triangle_dist2(q, tp[g[0]], tp[g[1]], tp[g[2]]) < min_d2 {
-                        why(format!("{:?} too close to a new face", fv));
                         return None;
                     }
                 }
@@ -147,7 +133,6 @@ pub fn check(
             // F has T's three vertices: it must be a new face of T, oppositely oriented.
             let l = [loc[0].unwrap(), loc[1].unwrap(), loc[2].unwrap()];
             if !l.contains(&3) {
-                why(format!("copy of base {:?}", fv));
                 return None; // a second copy of the base face
             }
             // Outward new faces of T are (0,1,3), (1,2,3), (2,0,3); F must be a cyclic
@@ -157,7 +142,6 @@ pub fn check(
                 .iter()
                 .any(|g| rot(*g).contains(&l));
             if !ok {
-                why(format!("same-orientation face {:?}", fv));
                 return None;
             }
             continue;
@@ -188,14 +172,12 @@ pub fn check(
         // Front vertices inside closed T.
         for k in 0..3 {
             if loc[k].is_none() && point_in_closed_tet(fp[k], tp[0], tp[1], tp[2], tp[3]) {
-                why(format!("vertex {} of {:?} inside", fv[k], fv));
                 return None;
             }
         }
         // New edges of T against F.
         for i in 0..3 {
             if segment_triangle_conflict([tp[i], tp[3]], [t[i], t[3]], fp, fv) {
-                why(format!("new edge {} crosses {:?}", i, fv));
                 return None;
             }
         }
@@ -210,10 +192,6 @@ pub fn check(
                 let gid = [t[g[0]], t[g[1]], t[g[2]]];
                 let gp = [tp[g[0]], tp[g[1]], tp[g[2]]];
                 if segment_triangle_conflict([fp[i], fp[j]], [ei, ej], gp, gid) {
-                    why(format!(
-                        "edge {ei}-{ej} of {:?} crosses new face {:?}",
-                        fv, gid
-                    ));
                     return None;
                 }
             }

@@ -48,11 +48,20 @@ pub fn torus(nu: usize, nv: usize, big_r: f64, r: f64) -> (Vec<P3>, Vec<[u32; 6]
             if j % 2 == 0 {
                 // Ring j at u = i, ring j+1 at u = i + 1/2.
                 tri([p(i, j, v0), p(i + 1, j, v0), p(i, j + 1, v1)], &mut nodes);
-                tri([p(i + 1, j, v0), p(i + 1, j + 1, v1), p(i, j + 1, v1)], &mut nodes);
+                tri(
+                    [p(i + 1, j, v0), p(i + 1, j + 1, v1), p(i, j + 1, v1)],
+                    &mut nodes,
+                );
             } else {
                 // Ring j at u = i + 1/2, ring j+1 at u = i.
-                tri([p(i, j, v0), p(i + 1, j, v0), p(i + 1, j + 1, v1)], &mut nodes);
-                tri([p(i, j, v0), p(i + 1, j + 1, v1), p(i, j + 1, v1)], &mut nodes);
+                tri(
+                    [p(i, j, v0), p(i + 1, j, v0), p(i + 1, j + 1, v1)],
+                    &mut nodes,
+                );
+                tri(
+                    [p(i, j, v0), p(i + 1, j + 1, v1), p(i, j + 1, v1)],
+                    &mut nodes,
+                );
             }
         }
     }
