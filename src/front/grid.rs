@@ -40,8 +40,8 @@ impl Aabb {
     #[inline]
     pub fn dist2(&self, p: P3) -> f64 {
         let mut s = 0.0;
-        for d in 0..3 {
-            let e = (self.lo[d] - p[d]).max(p[d] - self.hi[d]).max(0.0);
+        for (d, x) in p.iter().enumerate() {
+            let e = (self.lo[d] - x).max(x - self.hi[d]).max(0.0);
             s += e * e;
         }
         s

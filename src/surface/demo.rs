@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 pub fn torus(nu: usize, nv: usize, big_r: f64, r: f64) -> (Vec<P3>, Vec<[u32; 6]>) {
     use std::collections::HashMap;
     let nu = nu.max(3);
-    let nv = (nv.max(4) + 1) / 2 * 2;
+    let nv = nv.max(4).div_ceil(2) * 2;
     // Parametric position (u in corner steps, v in ring steps) -> point; periodic.
     let x = |u: f64, v: f64| -> P3 {
         let (su, cu) = (2.0 * PI * u / nu as f64).sin_cos();
