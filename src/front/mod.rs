@@ -613,7 +613,6 @@ impl<'a> Mesher<'a> {
             _ => 0.0,
         };
         let mut chosen = None;
-        if cands.is_empty() {}
         for cd in &cands {
             let apex = if cd.id == NEW {
                 validity::NEW_POINT
