@@ -10,6 +10,7 @@
 //! faces close them.
 
 mod cavity;
+mod diagnose;
 mod grid;
 mod repair;
 pub mod size;
@@ -441,13 +442,16 @@ impl<'a> Mesher<'a> {
         ]
     }
 
-    fn stuck_error(&self, fid: u32, why: &str) -> Error {
+    fn stuck_error(&mut self, fid: u32, why: &str) -> Error {
         let v = self.faces[fid as usize].v;
         let c = {
             let p = self.face_pts(fid);
             centroid3(p[0], p[1], p[2])
         };
         let open = self.faces.iter().filter(|f| f.alive).count();
+        if std::env::var_os("CURVETET_DIAGNOSE").is_some() {
+            eprintln!("{}", self.diagnose(fid));
+        }
         Error::MeshingFailed {
             msg: format!(
                 "{why}: the front could not be closed near ({:.6}, {:.6}, {:.6}) at face with vertices {:?}; {open} front faces remain open",
@@ -629,7 +633,7 @@ impl<'a> Mesher<'a> {
             self.gather_near(&bb, fid);
             let pts = &self.pts;
             let pos = |i: u32| pts[i as usize];
-            let Some(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
+            let Ok(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
                 continue;
             };
             if verdict.min_gap_deg < min_gap || verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG
@@ -653,23 +657,19 @@ impl<'a> Mesher<'a> {
                     p2_invalid = true;
                 }
             }
-            // Look ahead: every thin wedge T leaves must be closable by a valid tet.
-            // (Against boundary faces at every level: those wedges can never be reopened.)
-            let closable = (0..verdict.num_closings).all(|i| {
+            // Look ahead: every thin wedge T leaves must be closable by a valid tet, with
+            // T in place. (Against boundary faces at every level: those wedges can never
+            // be reopened.)
+            let mut closable = true;
+            for i in 0..verdict.num_closings {
                 if level >= 2 && !verdict.closing_on_boundary[i] {
-                    return true;
+                    continue;
                 }
-                let c = verdict.closings[i];
-                let ct = c.map(|v| {
-                    if v == validity::NEW_POINT {
-                        cd.p
-                    } else {
-                        self.pts[v as usize]
-                    }
-                });
-                orient3d(ct[0], ct[1], ct[2], ct[3]) > 0
-                    && self.p2_nodes(c, &ct).map_or(true, |x| curved_valid(&x))
-            });
+                if !self.closing_ok(verdict.closings[i], t, cd.p) {
+                    closable = false;
+                    break;
+                }
+            }
             if !closable && level < 3 {
                 continue;
             }
@@ -691,6 +691,44 @@ impl<'a> Mesher<'a> {
         };
         self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid);
         true
+    }
+
+    /// Can the thin wedge between front face `c[0..3]` and candidate tet `t` (apex
+    /// position `apex`) be closed by tet `c` once `t` is in place? Exact validity against
+    /// the front around both, with `t`'s new faces added, and certified P2 validity.
+    fn closing_ok(&mut self, c: [u32; 4], t: [u32; 4], apex: P3) -> bool {
+        let pos = |v: u32, pts: &[P3]| if v == validity::NEW_POINT { apex } else { pts[v as usize] };
+        let ct = c.map(|v| pos(v, &self.pts));
+        if orient3d(ct[0], ct[1], ct[2], ct[3]) <= 0 {
+            return false;
+        }
+        if !self.p2_nodes(c, &ct).map_or(true, |x| curved_valid(&x)) {
+            return false;
+        }
+        let tp = t.map(|v| pos(v, &self.pts));
+        let mut bb = Aabb::of(&ct);
+        let tb = Aabb::of(&tp);
+        for d in 0..3 {
+            bb.lo[d] = bb.lo[d].min(tb.lo[d]);
+            bb.hi[d] = bb.hi[d].max(tb.hi[d]);
+        }
+        let base_key = key3([c[0], c[1], c[2]]);
+        let t_base = key3([t[0], t[1], t[2]]);
+        let base_id = self.face_map.get(&base_key).copied().unwrap_or(u32::MAX);
+        self.gather_near(&bb, base_id);
+        // The front after T: T's base face gone, its new faces added.
+        self.near.retain(|f| key3(f.v) != t_base);
+        for g in &TET_OUT_FACES[1..] {
+            let v = [t[g[0]], t[g[1]], t[g[2]]];
+            let k = key3(v);
+            if let Some(j) = self.near.iter().position(|f| key3(f.v) == k) {
+                self.near.swap_remove(j);
+            } else {
+                self.near.push(FaceRef { v, boundary: false });
+            }
+        }
+        let pts = &self.pts;
+        validity::check(c, ct, &self.near, |v| pos(v, pts), 0.0).is_ok()
     }
 
     /// Fill `self.near` with the live front faces whose grid cells meet `bb`, except
