@@ -23,7 +23,8 @@ impl Mesher<'_> {
         let a = axpy(c, h, n);
         let r = 3.0 * self.opts.alpha * h;
         let mut out = String::new();
-        let _ = writeln!(
+        let _ =
+            writeln!(
             out,
             "face {fid} {:?} (boundary triangle {}) at {:?}, mean edge {lf:.4}, field size {:.4}",
             f.v,
@@ -44,7 +45,10 @@ impl Mesher<'_> {
             if let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) {
                 let gv = self.faces[g as usize].v;
                 let w = self.wedge_deg(fid, g);
-                let _ = writeln!(out, "  neighbour across edge {k}: face {g} {gv:?}, wedge {w:.2} deg");
+                let _ = writeln!(
+                    out,
+                    "  neighbour across edge {k}: face {g} {gv:?}, wedge {w:.2} deg"
+                );
                 if let Some(&x) = gv.iter().find(|x| !f.v.contains(x)) {
                     ids.push(x);
                 }

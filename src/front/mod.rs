@@ -611,10 +611,12 @@ impl<'a> Mesher<'a> {
                 }
             }
         }
-        let prox = match level {
-            0 => 0.35 * target,
-            1 => 0.2 * target,
-            _ => 0.0,
+        // Proximity floors: (new point, existing vertex). A new point never comes right
+        // against the front, whatever the level: it would leave a sliver layer.
+        let (prox_new, prox_old) = match level {
+            0 => (0.35 * target, 0.35 * target),
+            1 => (0.2 * target, 0.2 * target),
+            _ => (0.12 * target, 0.0),
         };
         let mut chosen = None;
         for cd in &cands {
@@ -625,6 +627,7 @@ impl<'a> Mesher<'a> {
             };
             let t = [f.v[0], f.v[1], f.v[2], apex];
             let tp = [fp[0], fp[1], fp[2], cd.p];
+            let prox = if cd.id == NEW { prox_new } else { prox_old };
             let mut bb = Aabb::of(&tp);
             for d in 0..3 {
                 bb.lo[d] -= prox;
@@ -662,9 +665,6 @@ impl<'a> Mesher<'a> {
             // be reopened.)
             let mut closable = true;
             for i in 0..verdict.num_closings {
-                if level >= 2 && !verdict.closing_on_boundary[i] {
-                    continue;
-                }
                 if !self.closing_ok(verdict.closings[i], t, cd.p) {
                     closable = false;
                     break;
@@ -697,7 +697,13 @@ impl<'a> Mesher<'a> {
     /// position `apex`) be closed by tet `c` once `t` is in place? Exact validity against
     /// the front around both, with `t`'s new faces added, and certified P2 validity.
     fn closing_ok(&mut self, c: [u32; 4], t: [u32; 4], apex: P3) -> bool {
-        let pos = |v: u32, pts: &[P3]| if v == validity::NEW_POINT { apex } else { pts[v as usize] };
+        let pos = |v: u32, pts: &[P3]| {
+            if v == validity::NEW_POINT {
+                apex
+            } else {
+                pts[v as usize]
+            }
+        };
         let ct = c.map(|v| pos(v, &self.pts));
         if orient3d(ct[0], ct[1], ct[2], ct[3]) <= 0 {
             return false;

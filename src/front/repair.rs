@@ -47,8 +47,13 @@ impl Mesher<'_> {
         }
         // The ring grows with each repair here, but stays local: a few element sizes.
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let local = lf.min(self.size.at(c));
-        let radius = local * (0.75 + 0.5 * count.min(4) as f64);
+        let field = self.size.at(c);
+        let local = if count <= 2 {
+            lf.min(field)
+        } else {
+            lf.max(field)
+        };
+        let radius = local * (0.75 + 0.5 * count.min(6) as f64);
         let fv = self.faces[fid as usize].v;
         let r2 = radius * radius;
         let mut victims = Vec::new();
