@@ -53,7 +53,7 @@ impl Search<'_> {
             }
             let t = [f[0], f[1], f[2], v];
             let tp = [fp[0], fp[1], fp[2], p];
-            if validity::check(t, tp, &near, |i| (self.pos)(i), 0.0).is_none() {
+            if validity::check(t, tp, &near, |i| (self.pos)(i), 0.0).is_err() {
                 continue;
             }
             if !(self.curved_ok)(t, &tp) {

@@ -1,12 +1,13 @@
-//! A hashed uniform grid of front faces, for the "which front faces are near this
-//! candidate tetrahedron" query of the validity tests.
+//! A uniform grid of front faces, for the "which front faces are near this candidate
+//! tetrahedron" query of the validity tests.
 //!
 //! Hand-written rather than a crate: faces come and go at every step, the query is a box,
-//! and removal is lazy (dead ids are skipped and swept out when a cell gets dirty),
-//! which a general R-tree crate would make slower than this ~100-line structure.
+//! and removal is lazy (dead ids are skipped and swept out when a cell gets dirty), which
+//! a general R-tree crate would make slower than this small dense array of cell lists.
+//! The grid covers the surface's bounding box; the cell count is capped so memory stays
+//! proportional to the input (cells grow when the cap is reached).
 
 use crate::geom::vec3::P3;
-use std::collections::HashMap;
 
 /// Axis-aligned box.
 #[derive(Clone, Copy, Debug)]
@@ -35,48 +36,87 @@ impl Aabb {
     pub fn overlaps(&self, o: &Aabb) -> bool {
         (0..3).all(|d| self.lo[d] <= o.hi[d] && o.lo[d] <= self.hi[d])
     }
+    /// Squared distance from `p` to the box (0 inside).
+    #[inline]
+    pub fn dist2(&self, p: P3) -> f64 {
+        let mut s = 0.0;
+        for (d, x) in p.iter().enumerate() {
+            let e = (self.lo[d] - x).max(x - self.hi[d]).max(0.0);
+            s += e * e;
+        }
+        s
+    }
 }
 
-type Key = (i32, i32, i32);
-
-/// Uniform hashed grid of face ids.
+/// Dense uniform grid of face ids over a box.
 pub struct FaceGrid {
     inv: f64,
     origin: P3,
-    cells: HashMap<Key, Vec<u32>>,
+    dims: [usize; 3],
+    cells: Vec<Vec<u32>>,
     stamp: Vec<u32>,
     epoch: u32,
 }
 
 impl FaceGrid {
-    /// A grid with cubic cells of side `cell` anchored at `origin`.
-    pub fn new(origin: P3, cell: f64) -> FaceGrid {
+    /// A grid over `bounds` with cubic cells of side at least `cell`, at most `max_cells`
+    /// cells in all.
+    pub fn new(bounds: Aabb, cell: f64, max_cells: usize) -> FaceGrid {
+        let ext: [f64; 3] = std::array::from_fn(|d| (bounds.hi[d] - bounds.lo[d]).max(0.0));
+        let mut cell = if cell.is_finite() && cell > 0.0 {
+            cell
+        } else {
+            ext.iter().cloned().fold(1.0, f64::max)
+        };
+        let dims_for = |c: f64| -> [usize; 3] {
+            std::array::from_fn(|d| ((ext[d] / c).floor() as usize).clamp(0, 1 << 20) + 1)
+        };
+        let mut dims = dims_for(cell);
+        while dims[0].saturating_mul(dims[1]).saturating_mul(dims[2]) > max_cells.max(1) {
+            cell *= 1.25;
+            dims = dims_for(cell);
+        }
         FaceGrid {
             inv: 1.0 / cell,
-            origin,
-            cells: HashMap::new(),
+            origin: bounds.lo,
+            dims,
+            cells: vec![Vec::new(); dims[0] * dims[1] * dims[2]],
             stamp: Vec::new(),
             epoch: 0,
         }
     }
 
+    /// Cell index range covered by `b` (clamped to the grid: faces beyond it, which
+    /// cannot exist inside a closed surface's box, land in the border cells).
     #[inline]
-    fn key_range(&self, b: &Aabb) -> (Key, Key) {
-        let k = |p: P3| -> Key {
-            let f =
-                |d: usize| (((p[d] - self.origin[d]) * self.inv).floor()).clamp(-1e9, 1e9) as i32;
-            (f(0), f(1), f(2))
+    fn range(&self, b: &Aabb) -> ([usize; 3], [usize; 3]) {
+        let c = |x: f64, d: usize| -> usize {
+            let v = ((x - self.origin[d]) * self.inv).floor();
+            if v.is_nan() || v < 0.0 {
+                0
+            } else {
+                (v as usize).min(self.dims[d] - 1)
+            }
         };
-        (k(b.lo), k(b.hi))
+        (
+            [c(b.lo[0], 0), c(b.lo[1], 1), c(b.lo[2], 2)],
+            [c(b.hi[0], 0), c(b.hi[1], 1), c(b.hi[2], 2)],
+        )
+    }
+
+    #[inline]
+    fn index(&self, i: usize, j: usize, k: usize) -> usize {
+        (k * self.dims[1] + j) * self.dims[0] + i
     }
 
     /// Insert face `id` with bounding box `b`.
     pub fn insert(&mut self, id: u32, b: &Aabb) {
-        let (lo, hi) = self.key_range(b);
-        for i in lo.0..=hi.0 {
-            for j in lo.1..=hi.1 {
-                for k in lo.2..=hi.2 {
-                    self.cells.entry((i, j, k)).or_default().push(id);
+        let (lo, hi) = self.range(b);
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let c = self.index(i, j, k);
+                    self.cells[c].push(id);
                 }
             }
         }
@@ -94,42 +134,25 @@ impl FaceGrid {
             self.stamp.iter_mut().for_each(|s| *s = 0);
             self.epoch = 1;
         }
-        let (lo, hi) = self.key_range(b);
-        // Guard against absurd ranges (a huge box on a fine grid): cap the cell count.
-        let span = (hi.0 as i64 - lo.0 as i64 + 1)
-            * (hi.1 as i64 - lo.1 as i64 + 1)
-            * (hi.2 as i64 - lo.2 as i64 + 1);
-        if span > 4096 {
-            // Fall back to scanning every cell (rare: only for faces much larger than cells).
-            for list in self.cells.values_mut() {
-                list.retain(|&f| alive(f));
-                for &f in list.iter() {
-                    if self.stamp[f as usize] != self.epoch {
-                        self.stamp[f as usize] = self.epoch;
-                        out.push(f);
+        let (lo, hi) = self.range(b);
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let c = self.index(i, j, k);
+                    let list = &mut self.cells[c];
+                    let mut dead = 0;
+                    for &f in list.iter() {
+                        if !alive(f) {
+                            dead += 1;
+                            continue;
+                        }
+                        if self.stamp[f as usize] != self.epoch {
+                            self.stamp[f as usize] = self.epoch;
+                            out.push(f);
+                        }
                     }
-                }
-            }
-            return;
-        }
-        for i in lo.0..=hi.0 {
-            for j in lo.1..=hi.1 {
-                for k in lo.2..=hi.2 {
-                    if let Some(list) = self.cells.get_mut(&(i, j, k)) {
-                        let mut dead = 0;
-                        for &f in list.iter() {
-                            if !alive(f) {
-                                dead += 1;
-                                continue;
-                            }
-                            if self.stamp[f as usize] != self.epoch {
-                                self.stamp[f as usize] = self.epoch;
-                                out.push(f);
-                            }
-                        }
-                        if dead * 2 > list.len() {
-                            list.retain(|&f| alive(f));
-                        }
+                    if dead * 4 > list.len() {
+                        list.retain(|&f| alive(f));
                     }
                 }
             }

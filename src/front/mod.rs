@@ -10,6 +10,7 @@
 //! faces close them.
 
 mod cavity;
+mod diagnose;
 mod grid;
 mod repair;
 pub mod size;
@@ -24,9 +25,10 @@ use crate::options::Options;
 use crate::{Error, Result};
 use grid::{Aabb, FaceGrid};
 use kiddo::{MutableKdTree, SquaredEuclidean};
+use rustc_hash::FxHashMap as HashMap;
 use size::{regular_height, SizeField};
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use std::collections::BinaryHeap;
 use validity::{FaceRef, TET_OUT_FACES};
 
 /// What the front produced: straight-sided tets on low-order vertices.
@@ -54,6 +56,9 @@ pub struct FrontStats {
     pub deleted: u64,
     /// Stuck cavities closed by the exact search.
     pub cavities: u64,
+    /// Tets accepted as a last resort with a non-positive P2 Jacobian (linear-valid, with
+    /// a free mid node), left for the high-order optimizer to untangle.
+    pub p2_invalid: u64,
 }
 
 #[derive(Clone, Copy)]
@@ -65,6 +70,9 @@ struct Face {
     btri: u32,
     /// Version: queue entries with an older version are stale.
     ver: u32,
+    /// Current queue class (0: thin wedge, 1: by size) and key.
+    qclass: u8,
+    qkey: f64,
 }
 
 /// A queue entry: (tries, class, key, face, version); smallest first.
@@ -95,14 +103,10 @@ struct Cand {
 }
 
 const NEW: u32 = u32::MAX;
-thread_local! { pub static WHYSTAT: std::cell::RefCell<std::collections::BTreeMap<String, u64>> = const { std::cell::RefCell::new(std::collections::BTreeMap::new()) }; }
-thread_local! { pub static NEARSTAT: std::cell::RefCell<[[u64;3];3]> = const { std::cell::RefCell::new([[0;3];3]) }; }
-thread_local! { static LEVEL: std::cell::RefCell<u8> = const { std::cell::RefCell::new(0) }; }
 /// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
 /// thinner one could only be closed by a flat tet with a curved face, which is invalid
 /// on concave boundaries, and boundary faces can never be remeshed.
 const MIN_BOUNDARY_GAP_DEG: f64 = 5.0;
-thread_local! { pub static FAILS: std::cell::RefCell<[[u64;4];3]> = const { std::cell::RefCell::new([[0;4];3]) }; }
 
 #[inline]
 fn key3(v: [u32; 3]) -> [u32; 3] {
@@ -123,6 +127,8 @@ pub(crate) struct Mesher<'a> {
     vdeg: Vec<u32>,
     in_tree: Vec<bool>,
     faces: Vec<Face>,
+    /// `faces[i].alive`, compact (the grid reads it for every listed face).
+    face_alive: Vec<bool>,
     face_map: HashMap<[u32; 3], u32>,
     btri_map: HashMap<[u32; 3], u32>,
     bedge_mid: HashMap<(u32, u32), u32>,
@@ -154,7 +160,8 @@ impl<'a> Mesher<'a> {
         let n_surf = surf_nodes.len();
         let mut edge_len_sum = 0.0;
         let mut edge_len_max = 0.0f64;
-        let mut bedge_mid = HashMap::with_capacity(surf_tris.len() * 3 / 2);
+        let mut bedge_mid =
+            HashMap::with_capacity_and_hasher(surf_tris.len() * 3 / 2, Default::default());
         for t in surf_tris {
             for (k, [i, j]) in crate::geom::shape::TRI6_EDGES.iter().enumerate() {
                 let (a, b) = (t[*i], t[*j]);
@@ -165,7 +172,6 @@ impl<'a> Mesher<'a> {
             }
         }
         let mean_edge = edge_len_sum / (3 * surf_tris.len()).max(1) as f64;
-        let lo = Aabb::of(surf_nodes).lo;
         let cell = mean_edge.max(edge_len_max / 8.0);
         let mut m = Mesher {
             opts,
@@ -176,18 +182,23 @@ impl<'a> Mesher<'a> {
             vdeg: vec![0; n_surf],
             in_tree: vec![false; n_surf],
             faces: Vec::with_capacity(surf_tris.len() * 4),
-            face_map: HashMap::with_capacity(surf_tris.len() * 2),
-            btri_map: HashMap::with_capacity(surf_tris.len()),
+            face_alive: Vec::with_capacity(surf_tris.len() * 4),
+            face_map: HashMap::with_capacity_and_hasher(surf_tris.len() * 2, Default::default()),
+            btri_map: HashMap::with_capacity_and_hasher(surf_tris.len(), Default::default()),
             bedge_mid,
             heap: BinaryHeap::new(),
-            edges: HashMap::with_capacity(surf_tris.len() * 6),
-            grid: FaceGrid::new(lo, cell),
+            edges: HashMap::with_capacity_and_hasher(surf_tris.len() * 6, Default::default()),
+            grid: FaceGrid::new(
+                Aabb::of(surf_nodes),
+                cell,
+                (16 * surf_tris.len()).max(1 << 16),
+            ),
             vtree: MutableKdTree::default(),
             tets: Vec::new(),
             tet_alive: Vec::new(),
             size,
             stats: FrontStats::default(),
-            repairs_at: HashMap::new(),
+            repairs_at: HashMap::default(),
             repair_cell: 2.0 * mean_edge,
             near_ids: Vec::new(),
             near: Vec::new(),
@@ -202,22 +213,7 @@ impl<'a> Mesher<'a> {
         m
     }
 
-    fn trace(&self, what: &str, v: [u32; 3]) {
-        if let Ok(t) = std::env::var("CURVETET_TRACE") {
-            let set: Vec<u32> = t.split(',').filter_map(|x| x.parse().ok()).collect();
-            if v.iter().all(|x| set.contains(x)) {
-                eprintln!(
-                    "TRACE {what} {:?} step {} tets {}",
-                    v,
-                    self.stats.steps,
-                    self.tets.len()
-                );
-            }
-        }
-    }
-
     fn add_face(&mut self, v: [u32; 3]) {
-        self.trace("add", v);
         let id = self.faces.len() as u32;
         let k = key3(v);
         let btri = if v.iter().all(|&x| (x as usize) < self.n_surf) {
@@ -225,12 +221,15 @@ impl<'a> Mesher<'a> {
         } else {
             u32::MAX
         };
+        self.face_alive.push(true);
         self.faces.push(Face {
             v,
             alive: true,
             tries: 0,
             btri,
             ver: 0,
+            qclass: 1,
+            qkey: 0.0,
         });
         for k in 0..3 {
             self.edges.insert((v[k], v[(k + 1) % 3]), id);
@@ -251,11 +250,15 @@ impl<'a> Mesher<'a> {
             }
         }
         self.enqueue(id);
-        // The neighbours' wedges changed.
+        // A neighbour now in a thinner wedge moves up the queue.
         for k in 0..3 {
             if let Some(&g) = self.edges.get(&(v[(k + 1) % 3], v[k])) {
-                self.faces[g as usize].ver += 1;
-                self.enqueue(g);
+                let w = self.wedge_deg(g, id);
+                let gf = self.faces[g as usize];
+                if w < WEDGE_FIRST_DEG && (gf.qclass == 1 || w < gf.qkey) {
+                    self.faces[g as usize].ver += 1;
+                    self.enqueue(g);
+                }
             }
         }
     }
@@ -306,7 +309,7 @@ impl<'a> Mesher<'a> {
         }
         f.alive = false;
         let v = f.v;
-        self.trace("kill", v);
+        self.face_alive[id as usize] = false;
         for k in 0..3 {
             let e = (v[k], v[(k + 1) % 3]);
             if self.edges.get(&e) == Some(&id) {
@@ -378,25 +381,6 @@ impl<'a> Mesher<'a> {
                 continue;
             }
             self.stats.steps += 1;
-            if self.stats.steps % 20000 == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
-                let open = self.faces.iter().filter(|f| f.alive).count();
-                eprintln!("why {:?}", WHYSTAT.with(|m| m.borrow().clone()));
-                eprintln!(
-                    "fails {:?} near {:?}",
-                    FAILS.with(|f| *f.borrow()),
-                    NEARSTAT.with(|f| *f.borrow())
-                );
-                eprintln!(
-                    "step {} tets {} pts {} open {} tries {} stats {:?} vol {:.4}",
-                    self.stats.steps,
-                    self.tets.len(),
-                    self.pts.len(),
-                    open,
-                    tries,
-                    self.stats,
-                    self.volume_done
-                );
-            }
             if self.stats.steps > max_steps {
                 return Err(self.stuck_error(fid, "step limit reached"));
             }
@@ -435,6 +419,11 @@ impl<'a> Mesher<'a> {
                     continue;
                 }
             }
+            // ...else, where remeshing has not helped, accept a tet the optimizer must
+            // untangle...
+            if self.repair_count(fid) >= 4 && self.advance(fid, 3) {
+                continue;
+            }
             // ...else remesh around it.
             if self.stats.repairs >= max_repairs {
                 return Err(self.stuck_error(fid, "repair limit reached"));
@@ -453,78 +442,15 @@ impl<'a> Mesher<'a> {
         ]
     }
 
-    fn stuck_error(&self, fid: u32, why: &str) -> Error {
+    fn stuck_error(&mut self, fid: u32, why: &str) -> Error {
         let v = self.faces[fid as usize].v;
         let c = {
             let p = self.face_pts(fid);
             centroid3(p[0], p[1], p[2])
         };
         let open = self.faces.iter().filter(|f| f.alive).count();
-        if std::env::var_os("CURVETET_DEBUG3").is_some() {
-            // For each live face, find faces sharing all of its edges pairwise -> tet cavities
-            let alive: Vec<u32> = (0..self.faces.len() as u32)
-                .filter(|&i| self.faces[i as usize].alive)
-                .collect();
-            for &i in &alive {
-                let f = self.faces[i as usize];
-                // candidate 4th vertex: vertices of other alive faces sharing an edge
-                for &j in &alive {
-                    if i == j {
-                        continue;
-                    }
-                    let g = self.faces[j as usize];
-                    let sh = g.v.iter().filter(|x| f.v.contains(x)).count();
-                    if sh == 2 {
-                        let p = *g.v.iter().find(|x| !f.v.contains(x)).unwrap();
-                        // is there a 4-cavity?
-                        let t = [f.v[0], f.v[1], f.v[2], p];
-                        let cnt = alive
-                            .iter()
-                            .filter(|&&k| {
-                                let h = self.faces[k as usize].v;
-                                h.iter().all(|x| t.contains(x))
-                            })
-                            .count();
-                        if cnt == 4 {
-                            let tp = t.map(|x| self.pts[x as usize]);
-                            let near: Vec<FaceRef> = alive
-                                .iter()
-                                .filter(|&&k| k != i)
-                                .map(|&k| FaceRef {
-                                    v: self.faces[k as usize].v,
-                                    boundary: self.faces[k as usize].btri != u32::MAX,
-                                })
-                                .collect();
-                            let pts = &self.pts;
-                            let v = validity::check(t, tp, &near, |x: u32| pts[x as usize], 0.0);
-                            let w = validity::WHY.with(|w| w.borrow().clone());
-                            let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
-                            let o = orient3d(tp[0], tp[1], tp[2], tp[3]);
-                            let found = self
-                                .vtree
-                                .query(&tp[3])
-                                .within::<SquaredEuclidean<f64>>(1e-20)
-                                .unsorted()
-                                .execute();
-                            eprintln!("4-cavity {:?} orient {} valid {} ({}) curved {:?} in_tree {} found {} vdeg {} tries {}", t, o, v.is_some(), w, cur, self.in_tree[p as usize], found.len(), self.vdeg[p as usize], f.tries);
-                            break;
-                        }
-                    }
-                }
-            }
-        }
-        if let Some(path) = std::env::var_os("CURVETET_DUMP") {
-            use std::io::Write;
-            let mut w = std::fs::File::create(path).unwrap();
-            for f in self.faces.iter().filter(|f| f.alive) {
-                let p = f.v.map(|x| self.pts[x as usize]);
-                writeln!(
-                    w,
-                    "{} {} {} {:?} {:?} {:?} {}",
-                    f.v[0], f.v[1], f.v[2], p[0], p[1], p[2], f.btri
-                )
-                .unwrap();
-            }
+        if std::env::var_os("CURVETET_DIAGNOSE").is_some() {
+            eprintln!("{}", self.diagnose(fid));
         }
         Error::MeshingFailed {
             msg: format!(
@@ -537,7 +463,6 @@ impl<'a> Mesher<'a> {
 
     /// Try to build a tet on front face `fid` at relaxation `level`. True on success.
     fn advance(&mut self, fid: u32, level: u8) -> bool {
-        LEVEL.with(|l| *l.borrow_mut() = level);
         let f = self.faces[fid as usize];
         let fp = self.face_pts(fid);
         let c = centroid3(fp[0], fp[1], fp[2]);
@@ -591,6 +516,30 @@ impl<'a> Mesher<'a> {
                 q: 0.0,
                 dist_a: r.distance.sqrt(),
             });
+        }
+        // The vertices across the face's edges (the neighbours' apexes) are always
+        // candidates, however far: they are how a wedge closes, and with mixed sizes a
+        // large neighbour's apex can lie outside the search radius.
+        for k in 0..3 {
+            let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) else {
+                continue;
+            };
+            let gv = self.faces[g as usize].v;
+            let Some(&id) = gv.iter().find(|x| !f.v.contains(x)) else {
+                continue;
+            };
+            if self.cands.iter().any(|c| c.id == id) {
+                continue;
+            }
+            let p = self.pts[id as usize];
+            if orient3d(fp[0], fp[1], fp[2], p) > 0 {
+                self.cands.push(Cand {
+                    id,
+                    p,
+                    q: 0.0,
+                    dist_a: dist(p, a),
+                });
+            }
         }
         // New points: the ideal one, and lower ones when relaxing.
         let heights: &[f64] = match level {
@@ -662,53 +611,14 @@ impl<'a> Mesher<'a> {
                 }
             }
         }
-        // Nearby front faces for the validity tests: everything that can touch any candidate.
-        let mut bb = Aabb::of(&fp);
-        for cd in &cands {
-            for d in 0..3 {
-                bb.lo[d] = bb.lo[d].min(cd.p[d]);
-                bb.hi[d] = bb.hi[d].max(cd.p[d]);
-            }
-        }
-        let faces = &self.faces;
-        let mut near_ids = std::mem::take(&mut self.near_ids);
-        self.grid
-            .query(&bb, |i| faces[i as usize].alive, &mut near_ids);
-        self.near.clear();
-        for &i in &near_ids {
-            if i != fid {
-                self.near.push(FaceRef {
-                    v: self.faces[i as usize].v,
-                    boundary: self.faces[i as usize].btri != u32::MAX,
-                });
-            }
-        }
-        self.near_ids = near_ids;
-        if self.near.len() > 400 && std::env::var_os("CURVETET_DEBUG4").is_some() {
-            eprintln!(
-                "big near {} bb {:?} cands {} h {} fp {:?}",
-                self.near.len(),
-                bb,
-                cands.len(),
-                h,
-                fp
-            );
-        }
-        NEARSTAT.with(|n| {
-            let mut n = n.borrow_mut();
-            n[level as usize][0] += 1;
-            n[level as usize][1] += self.near.len() as u64;
-            n[level as usize][2] += cands.len() as u64;
-        });
-        let prox = match level {
-            0 => 0.35 * target,
-            1 => 0.2 * target,
-            _ => 0.0,
+        // Proximity floors: (new point, existing vertex). A new point never comes right
+        // against the front, whatever the level: it would leave a sliver layer.
+        let (prox_new, prox_old) = match level {
+            0 => (0.35 * target, 0.35 * target),
+            1 => (0.2 * target, 0.2 * target),
+            _ => (0.12 * target, 0.0),
         };
         let mut chosen = None;
-        if cands.is_empty() {
-            FAILS.with(|f| f.borrow_mut()[level as usize][0] += 1);
-        }
         for cd in &cands {
             let apex = if cd.id == NEW {
                 validity::NEW_POINT
@@ -717,86 +627,57 @@ impl<'a> Mesher<'a> {
             };
             let t = [f.v[0], f.v[1], f.v[2], apex];
             let tp = [fp[0], fp[1], fp[2], cd.p];
+            let prox = if cd.id == NEW { prox_new } else { prox_old };
+            let mut bb = Aabb::of(&tp);
+            for d in 0..3 {
+                bb.lo[d] -= prox;
+                bb.hi[d] += prox;
+            }
+            self.gather_near(&bb, fid);
             let pts = &self.pts;
             let pos = |i: u32| pts[i as usize];
-            let Some(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
-                FAILS.with(|f| f.borrow_mut()[level as usize][1] += 1);
-                if level == 0 && std::env::var_os("CURVETET_DEBUG").is_some() {
-                    let w = validity::WHY.with(|w| w.borrow().clone());
-                    let cat: String = w
-                        .chars()
-                        .filter(|c| c.is_alphabetic() || *c == ' ')
-                        .collect::<String>()
-                        .split_whitespace()
-                        .collect::<Vec<_>>()
-                        .join(" ");
-                    let cat = format!("{}{}", if cd.id == NEW { "NEW " } else { "OLD " }, cat);
-                    WHYSTAT.with(|m| *m.borrow_mut().entry(cat).or_insert(0) += 1);
-                }
+            let Ok(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
                 continue;
             };
             if verdict.min_gap_deg < min_gap || verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG
             {
-                FAILS.with(|f| f.borrow_mut()[level as usize][2] += 1);
                 continue;
             }
+            let mut p2_invalid = false;
             if let Some(x) = self.p2_nodes(t, &tp) {
                 if !curved_valid(&x) {
-                    FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
-                    continue;
+                    // Last resort (level 3): a linear-valid tet whose P2 Jacobian is not
+                    // positive, if it has a free mid node the optimizer can move.
+                    let free_edge = TET10_EDGES.iter().any(|[i, j]| {
+                        let (a, b) = (t[*i], t[*j]);
+                        !((a as usize) < self.n_surf
+                            && (b as usize) < self.n_surf
+                            && self.bedge_mid.contains_key(&(a.min(b), a.max(b))))
+                    });
+                    if level < 3 || !free_edge {
+                        continue;
+                    }
+                    p2_invalid = true;
                 }
             }
-            // Look ahead: every thin wedge T leaves must be closable by a valid tet.
-            let closable = verdict.closings[..verdict.num_closings].iter().all(|c| {
-                let ct = c.map(|v| {
-                    if v == validity::NEW_POINT {
-                        cd.p
-                    } else {
-                        self.pts[v as usize]
-                    }
-                });
-                orient3d(ct[0], ct[1], ct[2], ct[3]) > 0
-                    && self.p2_nodes(*c, &ct).map_or(true, |x| curved_valid(&x))
-            });
-            if !closable && level < 2 {
-                FAILS.with(|f| f.borrow_mut()[level as usize][3] += 1);
+            // Look ahead: every thin wedge T leaves must be closable by a valid tet, with
+            // T in place. (Against boundary faces at every level: those wedges can never
+            // be reopened.)
+            let mut closable = true;
+            for i in 0..verdict.num_closings {
+                if !self.closing_ok(verdict.closings[i], t, cd.p) {
+                    closable = false;
+                    break;
+                }
+            }
+            if !closable && level < 3 {
                 continue;
+            }
+            if p2_invalid {
+                self.stats.p2_invalid += 1;
             }
             chosen = Some(*cd);
             break;
-        }
-        if chosen.is_none() && level == 2 && std::env::var_os("CURVETET_DEBUG2").is_some() {
-            let mut why = Vec::new();
-            for cd in &cands {
-                let apex = if cd.id == NEW {
-                    validity::NEW_POINT
-                } else {
-                    cd.id
-                };
-                let t = [f.v[0], f.v[1], f.v[2], apex];
-                let tp = [fp[0], fp[1], fp[2], cd.p];
-                let pts = &self.pts;
-                let v = validity::check(t, tp, &self.near, |i: u32| pts[i as usize], 0.0);
-                let cur = self.p2_nodes(t, &tp).map(|x| curved_valid(&x));
-                let w = validity::WHY.with(|w| w.borrow().clone());
-                why.push(format!(
-                    "{}:{}:{:?}:{}",
-                    if cd.id == NEW { -1 } else { cd.id as i64 },
-                    v.is_some(),
-                    cur,
-                    w
-                ));
-            }
-            eprintln!(
-                "stuck face {} {:?} btri {} found {} cands {} near {}: {}",
-                fid,
-                f.v,
-                f.btri,
-                found.len(),
-                cands.len(),
-                self.near.len(),
-                why.join(" ")
-            );
         }
         self.cands = cands;
         let Some(cd) = chosen else {
@@ -810,6 +691,69 @@ impl<'a> Mesher<'a> {
         };
         self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid);
         true
+    }
+
+    /// Can the thin wedge between front face `c[0..3]` and candidate tet `t` (apex
+    /// position `apex`) be closed by tet `c` once `t` is in place? Exact validity against
+    /// the front around both, with `t`'s new faces added, and certified P2 validity.
+    fn closing_ok(&mut self, c: [u32; 4], t: [u32; 4], apex: P3) -> bool {
+        let pos = |v: u32, pts: &[P3]| {
+            if v == validity::NEW_POINT {
+                apex
+            } else {
+                pts[v as usize]
+            }
+        };
+        let ct = c.map(|v| pos(v, &self.pts));
+        if orient3d(ct[0], ct[1], ct[2], ct[3]) <= 0 {
+            return false;
+        }
+        if !self.p2_nodes(c, &ct).map_or(true, |x| curved_valid(&x)) {
+            return false;
+        }
+        let tp = t.map(|v| pos(v, &self.pts));
+        let mut bb = Aabb::of(&ct);
+        let tb = Aabb::of(&tp);
+        for d in 0..3 {
+            bb.lo[d] = bb.lo[d].min(tb.lo[d]);
+            bb.hi[d] = bb.hi[d].max(tb.hi[d]);
+        }
+        let base_key = key3([c[0], c[1], c[2]]);
+        let t_base = key3([t[0], t[1], t[2]]);
+        let base_id = self.face_map.get(&base_key).copied().unwrap_or(u32::MAX);
+        self.gather_near(&bb, base_id);
+        // The front after T: T's base face gone, its new faces added.
+        self.near.retain(|f| key3(f.v) != t_base);
+        for g in &TET_OUT_FACES[1..] {
+            let v = [t[g[0]], t[g[1]], t[g[2]]];
+            let k = key3(v);
+            if let Some(j) = self.near.iter().position(|f| key3(f.v) == k) {
+                self.near.swap_remove(j);
+            } else {
+                self.near.push(FaceRef { v, boundary: false });
+            }
+        }
+        let pts = &self.pts;
+        validity::check(c, ct, &self.near, |v| pos(v, pts), 0.0).is_ok()
+    }
+
+    /// Fill `self.near` with the live front faces whose grid cells meet `bb`, except
+    /// face `exclude`.
+    fn gather_near(&mut self, bb: &Aabb, exclude: u32) {
+        let alive = &self.face_alive;
+        let mut ids = std::mem::take(&mut self.near_ids);
+        self.grid.query(bb, |i| alive[i as usize], &mut ids);
+        self.near.clear();
+        for &i in &ids {
+            if i != exclude {
+                let f = &self.faces[i as usize];
+                self.near.push(FaceRef {
+                    v: f.v,
+                    boundary: f.btri != u32::MAX,
+                });
+            }
+        }
+        self.near_ids = ids;
     }
 
     fn nearest_front_vertex(&self, p: P3, r: f64) -> f64 {
@@ -826,17 +770,6 @@ impl<'a> Mesher<'a> {
     }
 
     fn insert_tet(&mut self, t: [u32; 4], base: u32) {
-        if let Ok(tr) = std::env::var("CURVETET_TRACE") {
-            let set: Vec<u32> = tr.split(',').filter_map(|x| x.parse().ok()).collect();
-            if t.iter().filter(|x| set.contains(x)).count() >= 3 {
-                eprintln!(
-                    "TRACE tet {:?} base {:?} level {}",
-                    t,
-                    self.faces[base as usize].v,
-                    LEVEL.with(|l| *l.borrow())
-                );
-            }
-        }
         let tp = [0, 1, 2, 3].map(|k| self.pts[t[k] as usize]);
         self.volume_done += tet_det(tp[0], tp[1], tp[2], tp[3]) / 6.0;
         self.tets.push(t);

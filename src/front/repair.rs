@@ -8,25 +8,52 @@ use super::Mesher;
 use crate::geom::vec3::*;
 use crate::Result;
 
+/// Repairs allowed around one place before the front gives up there.
+const MAX_REPAIRS_PER_REGION: u32 = 12;
+
 impl Mesher<'_> {
+    fn repair_key(&self, fid: u32) -> (i32, i32, i32) {
+        let fp = self.face_pts(fid);
+        let c = centroid3(fp[0], fp[1], fp[2]);
+        let cell = self.repair_cell;
+        (
+            (c[0] / cell).floor() as i32,
+            (c[1] / cell).floor() as i32,
+            (c[2] / cell).floor() as i32,
+        )
+    }
+
+    /// Repairs done so far around face `fid`.
+    pub(super) fn repair_count(&self, fid: u32) -> u32 {
+        self.repairs_at
+            .get(&self.repair_key(fid))
+            .copied()
+            .unwrap_or(0)
+    }
+
     /// Delete the tets around stuck front face `fid` and requeue the faces nearby.
     pub(super) fn repair(&mut self, fid: u32) -> Result<()> {
         self.stats.repairs += 1;
         let fp = self.face_pts(fid);
         let c = centroid3(fp[0], fp[1], fp[2]);
-        let cell = self.repair_cell;
-        let key = (
-            (c[0] / cell).floor() as i32,
-            (c[1] / cell).floor() as i32,
-            (c[2] / cell).floor() as i32,
-        );
+        let key = self.repair_key(fid);
         let count = {
             let e = self.repairs_at.entry(key).or_insert(0);
             *e += 1;
             *e
         };
+        if count > MAX_REPAIRS_PER_REGION {
+            return Err(self.stuck_error(fid, "repeated local remeshing did not help"));
+        }
+        // The ring grows with each repair here, but stays local: a few element sizes.
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let radius = lf * (0.75 + 0.5 * count as f64);
+        let field = self.size.at(c);
+        let local = if count <= 2 {
+            lf.min(field)
+        } else {
+            lf.max(field)
+        };
+        let radius = local * (0.75 + 0.5 * count.min(6) as f64);
         let fv = self.faces[fid as usize].v;
         let r2 = radius * radius;
         let mut victims = Vec::new();

@@ -20,6 +20,29 @@ use crate::geom::vec3::*;
 /// opposite vertex k... except ordering: [base(opposite v3), opp v2, opp v0, opp v1].
 pub const TET_OUT_FACES: [[usize; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
 
+/// Why a candidate is not valid (for diagnostics; the front face involved, if any).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Conflict {
+    /// The apex is not strictly on the inner side of the base face.
+    NotPositive,
+    /// Flatter than f64 resolves (see [`MIN_RELATIVE_VOLUME`]).
+    Degenerate,
+    /// A new point too close to this unrelated front face.
+    ApexNearFace([u32; 3]),
+    /// A vertex of this front face too close to a new face.
+    VertexNearNewFace([u32; 3]),
+    /// This front face has the base face's vertices.
+    CopyOfBase([u32; 3]),
+    /// This front face is a new face of T with the same orientation.
+    SameOrientation([u32; 3]),
+    /// A vertex of this front face lies in T.
+    VertexInside([u32; 3]),
+    /// A new edge of T crosses this front face.
+    NewEdgeCrosses([u32; 3]),
+    /// An edge of this front face crosses a new face of T.
+    EdgeCrossesNewFace([u32; 3]),
+}
+
 /// The outcome of a validity test.
 #[derive(Clone, Copy, Debug)]
 pub struct Verdict {
@@ -33,7 +56,12 @@ pub struct Verdict {
     pub closings: [[u32; 4]; 6],
     /// Number of entries in `closings`.
     pub num_closings: usize,
+    /// Whether each closing's front face is a boundary face.
+    pub closing_on_boundary: [bool; 6],
 }
+
+/// Smallest 6 x volume / (longest edge)^3 of a tet the front creates.
+pub const MIN_RELATIVE_VOLUME: f64 = 1e-12;
 
 /// Id the caller gives a candidate's apex when it is a new point.
 pub const NEW_POINT: u32 = u32::MAX - 1;
@@ -50,16 +78,9 @@ pub struct FaceRef {
     pub boundary: bool,
 }
 
-thread_local! {
-/// Debug: why the last check failed.
-pub static WHY: std::cell::RefCell<String> = const { std::cell::RefCell::new(String::new()) }; }
-fn why(s: String) {
-    WHY.with(|w| *w.borrow_mut() = s);
-}
-
 /// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
 /// front, t[3] the apex) against the front faces `near` (excluding the base face).
-/// Returns `None` on any conflict. `min_dist` > 0 also rejects a new point (apex id
+/// Returns the first conflict found, if any. `min_dist` > 0 also rejects a new point (apex id
 /// [`NEW_POINT`]) that would come closer than that to an unrelated front face.
 pub fn check(
     t: [u32; 4],
@@ -67,9 +88,18 @@ pub fn check(
     near: &[FaceRef],
     pos: impl Fn(u32) -> P3,
     min_dist: f64,
-) -> Option<Verdict> {
+) -> Result<Verdict, Conflict> {
     if orient3d(tp[0], tp[1], tp[2], tp[3]) <= 0 {
-        return None;
+        return Err(Conflict::NotPositive);
+    }
+    // Numerically degenerate (flatter than f64 resolves relative to its size): its
+    // Jacobian could not be certified, so it is never created.
+    let l2 = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+        .iter()
+        .map(|&(i, j)| dist2(tp[i], tp[j]))
+        .fold(0.0, f64::max);
+    if tet_det(tp[0], tp[1], tp[2], tp[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt() {
+        return Err(Conflict::Degenerate);
     }
     let tb = Aabb::of(&tp);
     let tb_far = Aabb {
@@ -89,6 +119,7 @@ pub fn check(
     let mut min_gap_b = 360.0f64;
     let mut closings = [[0u32; 4]; 6];
     let mut num_closings = 0;
+    let mut closing_on_boundary = [false; 6];
     for f in near {
         let fv = f.v;
         let fp = [pos(fv[0]), pos(fv[1]), pos(fv[2])];
@@ -99,18 +130,21 @@ pub fn check(
         let in_t = |id: u32| t.iter().position(|&x| x == id);
         let loc = [in_t(fv[0]), in_t(fv[1]), in_t(fv[2])];
         let shared = loc.iter().filter(|x| x.is_some()).count();
-        if shared == 0 && min_d2 > 0.0 && t[3] == NEW_POINT {
+        if shared == 0 && min_d2 > 0.0 {
             // Proximity: an unrelated front face must not come close to T's apex, nor
             // its vertices close to T's new faces (a narrow gap would be left).
-            if point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2 {
-                why(format!("apex too close to {:?}", fv));
-                return None;
+            // (Box distances first: most faces are ruled out without the exact distance.)
+            if fb.dist2(tp[3]) < min_d2 && point_triangle_dist2(tp[3], fp[0], fp[1], fp[2]) < min_d2
+            {
+                return Err(Conflict::ApexNearFace(fv));
             }
             for q in fp {
+                if tb.dist2(q) >= min_d2 {
+                    continue;
+                }
                 for g in &TET_OUT_FACES[1..] {
                     if point_triangle_dist2(q, tp[g[0]], tp[g[1]], tp[g[2]]) < min_d2 {
-                        why(format!("{:?} too close to a new face", fv));
-                        return None;
+                        return Err(Conflict::VertexNearNewFace(fv));
                     }
                 }
             }
@@ -122,8 +156,7 @@ pub fn check(
             // F has T's three vertices: it must be a new face of T, oppositely oriented.
             let l = [loc[0].unwrap(), loc[1].unwrap(), loc[2].unwrap()];
             if !l.contains(&3) {
-                why(format!("copy of base {:?}", fv));
-                return None; // a second copy of the base face
+                return Err(Conflict::CopyOfBase(fv)); // a second copy of the base face
             }
             // Outward new faces of T are (0,1,3), (1,2,3), (2,0,3); F must be a cyclic
             // rotation of one of them reversed, i.e. a rotation of (1,0,3), (2,1,3), (0,2,3).
@@ -132,8 +165,7 @@ pub fn check(
                 .iter()
                 .any(|g| rot(*g).contains(&l));
             if !ok {
-                why(format!("same-orientation face {:?}", fv));
-                return None;
+                return Err(Conflict::SameOrientation(fv));
             }
             continue;
         }
@@ -150,6 +182,7 @@ pub fn check(
             let is_base_face = k != 3 && e0 != 3 && e1 != 3;
             if g < LOOKAHEAD_GAP_DEG && !is_base_face && num_closings < closings.len() {
                 closings[num_closings] = [fv[0], fv[1], fv[2], t[k]];
+                closing_on_boundary[num_closings] = f.boundary;
                 num_closings += 1;
             }
             if f.boundary {
@@ -162,15 +195,13 @@ pub fn check(
         // Front vertices inside closed T.
         for k in 0..3 {
             if loc[k].is_none() && point_in_closed_tet(fp[k], tp[0], tp[1], tp[2], tp[3]) {
-                why(format!("vertex {} of {:?} inside", fv[k], fv));
-                return None;
+                return Err(Conflict::VertexInside(fv));
             }
         }
         // New edges of T against F.
         for i in 0..3 {
             if segment_triangle_conflict([tp[i], tp[3]], [t[i], t[3]], fp, fv) {
-                why(format!("new edge {} crosses {:?}", i, fv));
-                return None;
+                return Err(Conflict::NewEdgeCrosses(fv));
             }
         }
         // Edges of F against the new faces of T.
@@ -184,20 +215,17 @@ pub fn check(
                 let gid = [t[g[0]], t[g[1]], t[g[2]]];
                 let gp = [tp[g[0]], tp[g[1]], tp[g[2]]];
                 if segment_triangle_conflict([fp[i], fp[j]], [ei, ej], gp, gid) {
-                    why(format!(
-                        "edge {ei}-{ej} of {:?} crosses new face {:?}",
-                        fv, gid
-                    ));
-                    return None;
+                    return Err(Conflict::EdgeCrossesNewFace(fv));
                 }
             }
         }
     }
-    Some(Verdict {
+    Ok(Verdict {
         min_gap_deg: min_gap,
         min_gap_boundary_deg: min_gap_b,
         closings,
         num_closings,
+        closing_on_boundary,
     })
 }
 

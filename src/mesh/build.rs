@@ -5,7 +5,7 @@
 use super::TetMesh;
 use crate::geom::shape::{TET10_EDGES, TRI6_EDGES};
 use crate::geom::vec3::{mid, P3};
-use std::collections::HashMap;
+use rustc_hash::FxHashMap as HashMap;
 
 /// Build the 10-node mesh. `pts[..n_surf]` are the surface nodes, the rest interior vertices.
 pub fn assemble(
@@ -15,7 +15,8 @@ pub fn assemble(
     surf_tris: &[[u32; 6]],
     surf_tags: &[i32],
 ) -> TetMesh {
-    let mut bedge: HashMap<(u32, u32), u32> = HashMap::with_capacity(surf_tris.len() * 3 / 2);
+    let mut bedge: HashMap<(u32, u32), u32> =
+        HashMap::with_capacity_and_hasher(surf_tris.len() * 3 / 2, Default::default());
     for t in surf_tris {
         for (k, [i, j]) in TRI6_EDGES.iter().enumerate() {
             let (a, b) = (t[*i], t[*j]);
@@ -36,7 +37,8 @@ pub fn assemble(
             }
         }
     }
-    let mut emid: HashMap<(u32, u32), u32> = HashMap::with_capacity(tets.len() * 2);
+    let mut emid: HashMap<(u32, u32), u32> =
+        HashMap::with_capacity_and_hasher(tets.len() * 2, Default::default());
     let mut out = Vec::with_capacity(tets.len());
     for t in tets {
         let c = t.map(|v| remap[v as usize]);
