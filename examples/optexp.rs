@@ -62,6 +62,9 @@ fn main() {
         r.num_invalid
     );
     worst(&mesh, surf.nodes().len(), 8);
+    if let Ok(t) = std::env::var("STAR") {
+        star_report(&mesh, surf.nodes().len(), t.parse().unwrap());
+    }
     let t = Instant::now();
     let c = cpu();
     let env = |k: &str, d: f64| {
@@ -165,5 +168,29 @@ pub fn worst_skew(mesh: &curvetet::TetMesh, n_surf: usize, k: usize) {
             "  skew tet {t}: skew {s:.3} bverts {nb} bfaces {faces} sj {:.3} dih {:.1}..{:.1}",
             q.scaled_jacobian_certified, q.min_dihedral, q.max_dihedral
         );
+    }
+}
+
+#[allow(dead_code)]
+pub fn star_report(mesh: &curvetet::TetMesh, n_surf: usize, t: usize) {
+    use curvetet::geom::quality::tet_quality;
+    use curvetet::mesh::quality::tet_nodes;
+    let e = mesh.tets[t];
+    println!("tet {t}: corners {:?} (n_surf {n_surf})", &e[..4]);
+    for &v in &e[..4] {
+        if (v as usize) < n_surf {
+            continue;
+        }
+        println!(" interior vertex {v} at {:?}", mesh.nodes[v as usize]);
+        for (s, f) in mesh.tets.iter().enumerate() {
+            if f[..4].contains(&v) {
+                let q = tet_quality(&tet_nodes(mesh, s));
+                let nb = f[..4].iter().filter(|&&x| (x as usize) < n_surf).count();
+                println!(
+                    "   star tet {s}: bverts {nb} skew {:.3} sj {:.3} dih {:.1}..{:.1}",
+                    q.skewness, q.scaled_jacobian_certified, q.min_dihedral, q.max_dihedral
+                );
+            }
+        }
     }
 }

@@ -25,14 +25,16 @@ const MEMORY: usize = 6;
 
 impl Lbfgs {
     /// Minimize `f` (value, writing the gradient into its second argument) from `x` for at
-    /// most `max_iter` iterations; the first step moves by at most `first_step`. Returns
-    /// the final value (`x` holds the minimizer found).
+    /// most `max_iter` iterations, or until `stop()` says so after an accepted step (the
+    /// last point `f` saw is then `x`); the first step moves by at most `first_step`.
+    /// Returns the final value (`x` holds the minimizer found).
     pub fn minimize(
         &mut self,
         x: &mut [f64],
         f: &mut impl FnMut(&[f64], &mut [f64]) -> f64,
         max_iter: usize,
         first_step: f64,
+        stop: &mut impl FnMut() -> bool,
     ) -> f64 {
         let n = x.len();
         self.g.resize(n, 0.0);
@@ -135,7 +137,7 @@ impl Lbfgs {
             self.g.copy_from_slice(&self.gn);
             let done = (fx - fnew).abs() <= 1e-12 * fx.abs().max(1e-300);
             fx = fnew;
-            if done {
+            if done || stop() {
                 break;
             }
         }
@@ -168,7 +170,7 @@ mod tests {
             g[1] = 200.0 * (b - a * a);
             (1.0 - a).powi(2) + 100.0 * (b - a * a).powi(2)
         };
-        let v = Lbfgs::default().minimize(&mut x, &mut f, 200, 0.1);
+        let v = Lbfgs::default().minimize(&mut x, &mut f, 200, 0.1, &mut || false);
         assert!(v < 1e-10, "{v} at {x:?}");
     }
 
@@ -183,7 +185,7 @@ mod tests {
             g[0] = 2.0 * (x[0] - 2.0) + 1.0 / (1.0 - x[0]);
             (x[0] - 2.0).powi(2) - (1.0 - x[0]).ln()
         };
-        Lbfgs::default().minimize(&mut x, &mut f, 100, 1.0);
+        Lbfgs::default().minimize(&mut x, &mut f, 100, 1.0, &mut || false);
         let exact = (3.0 - 3.0f64.sqrt()) / 2.0; // the root of 2x^2 - 6x + 3 below 1
         assert!((x[0] - exact).abs() < 1e-6, "{} vs {exact}", x[0]);
     }

@@ -26,6 +26,9 @@ use objective::{nodes, Objective, PatchElem, FIXED};
 use patch::{colour, Marks, NodeElems, Patch};
 use rayon::prelude::*;
 
+/// How far above the threshold an L-BFGS run may stop early.
+const STOP_SLACK: f64 = 0.03;
+
 /// Tuning of the high-order stage.
 #[derive(Clone, Debug)]
 pub struct HighOrderParams {
@@ -248,7 +251,11 @@ fn run_barrier(
     prm: &HighOrderParams,
     lb: &mut Lbfgs,
 ) -> u64 {
-    let mut obj = Objective { elems, eps: 0.0 };
+    let mut obj = Objective {
+        elems,
+        eps: 0.0,
+        last_ratio: Default::default(),
+    };
     let (mut mmin, ratio) = obj.min_measure(v);
     let mut evals = 0u64;
     if !mmin.is_finite() || mmin >= 1.0 || ratio >= prm.threshold {
@@ -260,11 +267,17 @@ fn run_barrier(
         } else {
             mmin - 0.1 * mmin.abs()
         };
+        let last = &obj.last_ratio;
+        let obj = &obj;
         let mut f = |v: &[f64], g: &mut [f64]| {
             evals += elems.len() as u64;
             obj.eval(v, g)
         };
-        lb.minimize(v, &mut f, prm.iterations, 0.02 * h);
+        // Stop a little above the threshold, so that the neighbours' later patches do
+        // not push these elements straight back below it.
+        let target = prm.threshold + STOP_SLACK;
+        let mut reached = || last.get() >= target;
+        lb.minimize(v, &mut f, prm.iterations, 0.02 * h, &mut reached);
         let (new, ratio) = obj.min_measure(v);
         let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
         mmin = new;
@@ -485,6 +498,7 @@ mod ceiling {
             let mut obj = Objective {
                 elems: &elems,
                 eps: 0.0,
+                last_ratio: Default::default(),
             };
             let mut lb = Lbfgs::default();
             let mut mmin = obj.min_measure(&v).0;
@@ -492,7 +506,7 @@ mod ceiling {
             for _ in 0..30 {
                 obj.eps = mmin - 0.1 * mmin.abs();
                 let mut f = |v: &[f64], g: &mut [f64]| obj.eval(v, g);
-                lb.minimize(&mut v, &mut f, 200, 0.02 * h);
+                lb.minimize(&mut v, &mut f, 200, 0.02 * h, &mut || false);
                 mmin = obj.min_measure(&v).0;
             }
             let s0 = scaled_jacobian_certified(&x, 1e-3);

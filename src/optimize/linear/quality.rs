@@ -12,6 +12,10 @@ use crate::geom::vec3::P3;
 use crate::optimize::dual::{dcross, ddot, dsub, D3, DP};
 use crate::optimize::Boundary;
 
+/// Weight of the straight-interior Bernstein ratio min b / max b of a curved tet with an
+/// interior vertex in its quality (so it counts as bad below 0.2).
+const CURVED_WEIGHT: f64 = 2.0;
+
 /// The quality measure of the linear stage (see the module docs).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ElementQuality;
@@ -52,11 +56,15 @@ impl ElementQuality {
                 };
                 return -1.0 + 0.5 * (1.0 + sj);
             }
+            let ratio = blo / bhi;
             if nb == 4 {
                 // No interior vertex: the high-order stage can move few nodes of this
                 // tet, so its curved shape counts here (unrefined Bernstein ratio).
-                return (1.0 - s).min(blo / bhi);
+                return (1.0 - s).min(ratio);
             }
+            // A curved tet barely valid with straight interior edges blocks every move
+            // of its corners: count it as bad, so it is worked on first.
+            return (1.0 - s).min(CURVED_WEIGHT * ratio);
         }
         1.0 - s
     }
