@@ -461,9 +461,41 @@ enum curvetet_status curvetet_surface_from_arrays(const double *xyz,
                                                   struct curvetet_surface **out);
 
 /**
- * Read a P2 surface from a file: Gmsh `.msh` (2.2/4.1, ASCII/binary), VTK `.vtu`/`.vtk`,
- * or medit `.mesh`, by extension. A volume mesh's file works too (its boundary
- * triangles are taken). The surface is checked as in `curvetet_surface_from_arrays`.
+ * Build a surface from a closed *linear* (3-node) triangle mesh: it is checked like a
+ * P2 surface (closed, manifold, oriented, no zero-area facet, no self-intersection),
+ * then curved (each edge gets a mid node on a smooth reconstruction; edges sharper than
+ * `feature_angle_deg` are features whose mid nodes follow the feature curve; flat
+ * regions stay flat; no curved triangle folds). The input vertices keep their indices
+ * and exact coordinates; mid nodes are appended after them.
+ *
+ * - `xyz`: `3 * num_nodes` coordinates; `tri3`: `3 * num_triangles` 0-based corners,
+ *   outward; `tags`: `num_triangles` tags or NULL; `feature_angle_deg`: e.g. 40
+ *   (0 < angle <= 180).
+ *
+ * On success `*out` is a new surface the caller owns (free it with
+ * `curvetet_surface_free`). On failure `*out` is NULL and the status is
+ * `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, bad
+ * angle) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and the
+ * facet, edge or vertex).
+ *
+ * # Safety
+ * Each non-NULL array must hold the number of elements stated above.
+ */
+enum curvetet_status curvetet_surface_from_linear(const double *xyz,
+                                                  size_t num_nodes,
+                                                  const uint32_t *tri3,
+                                                  size_t num_triangles,
+                                                  const int32_t *tags,
+                                                  double feature_angle_deg,
+                                                  struct curvetet_surface **out);
+
+/**
+ * Read a surface from a file, by extension: a P2 surface from Gmsh `.msh` (2.2/4.1,
+ * ASCII/binary), VTK `.vtu`/`.vtk` or medit `.mesh`; or a linear one from `.stl`,
+ * `.off`, `.obj`, `.ply` (or 3-node triangles in the formats above), which is curved as
+ * in `curvetet_surface_from_linear` with a 40 degree feature angle. A volume mesh's file
+ * works too (its boundary triangles are taken). The surface is checked as in
+ * `curvetet_surface_from_arrays`.
  *
  * On success `*out` is a new surface the caller owns (free it with
  * `curvetet_surface_free`). On failure `*out` is NULL and the status is

@@ -127,9 +127,63 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
     })
 }
 
-/// Read a P2 surface from a file: Gmsh `.msh` (2.2/4.1, ASCII/binary), VTK `.vtu`/`.vtk`,
-/// or medit `.mesh`, by extension. A volume mesh's file works too (its boundary
-/// triangles are taken). The surface is checked as in `curvetet_surface_from_arrays`.
+/// Build a surface from a closed *linear* (3-node) triangle mesh: it is checked like a
+/// P2 surface (closed, manifold, oriented, no zero-area facet, no self-intersection),
+/// then curved (each edge gets a mid node on a smooth reconstruction; edges sharper than
+/// `feature_angle_deg` are features whose mid nodes follow the feature curve; flat
+/// regions stay flat; no curved triangle folds). The input vertices keep their indices
+/// and exact coordinates; mid nodes are appended after them.
+///
+/// - `xyz`: `3 * num_nodes` coordinates; `tri3`: `3 * num_triangles` 0-based corners,
+///   outward; `tags`: `num_triangles` tags or NULL; `feature_angle_deg`: e.g. 40
+///   (0 < angle <= 180).
+///
+/// On success `*out` is a new surface the caller owns (free it with
+/// `curvetet_surface_free`). On failure `*out` is NULL and the status is
+/// `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, bad
+/// angle) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and the
+/// facet, edge or vertex).
+///
+/// # Safety
+/// Each non-NULL array must hold the number of elements stated above.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_from_linear(
+    xyz: *const f64,
+    num_nodes: usize,
+    tri3: *const u32,
+    num_triangles: usize,
+    tags: *const i32,
+    feature_angle_deg: f64,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    status_call("curvetet_surface_from_linear", || {
+        // SAFETY: `out` is the caller's; checked inside.
+        unsafe { reset_out(out)? };
+        let n3 = times(num_nodes, 3, "num_nodes")?;
+        let t3 = times(num_triangles, 3, "num_triangles")?;
+        // SAFETY: lengths as documented; NULL/alignment/size checked inside.
+        let (xyz, tri3) = unsafe { (input_slice(xyz, n3, "xyz")?, input_slice(tri3, t3, "tri3")?) };
+        let tags = if tags.is_null() {
+            Vec::new()
+        } else {
+            // SAFETY: as above.
+            unsafe { input_slice(tags, num_triangles, "tags")? }.to_vec()
+        };
+        let nodes: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let tris: Vec<[u32; 3]> = tri3.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let s = Surface::from_linear(nodes, tris, tags, feature_angle_deg)?;
+        // SAFETY: `out` checked by reset_out.
+        unsafe { give(out, s) };
+        Ok(())
+    })
+}
+
+/// Read a surface from a file, by extension: a P2 surface from Gmsh `.msh` (2.2/4.1,
+/// ASCII/binary), VTK `.vtu`/`.vtk` or medit `.mesh`; or a linear one from `.stl`,
+/// `.off`, `.obj`, `.ply` (or 3-node triangles in the formats above), which is curved as
+/// in `curvetet_surface_from_linear` with a 40 degree feature angle. A volume mesh's file
+/// works too (its boundary triangles are taken). The surface is checked as in
+/// `curvetet_surface_from_arrays`.
 ///
 /// On success `*out` is a new surface the caller owns (free it with
 /// `curvetet_surface_free`). On failure `*out` is NULL and the status is
@@ -149,7 +203,8 @@ pub unsafe extern "C" fn curvetet_surface_read(
         unsafe { reset_out(out)? };
         // SAFETY: NUL-terminated by contract.
         let path = unsafe { c_path(path)? };
-        let s = crate::io::read_surface(&path)?;
+        let s =
+            crate::io::read_any_surface(&path, &crate::surface::curve::CurveOptions::default())?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };
         Ok(())

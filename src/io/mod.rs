@@ -324,7 +324,7 @@ fn write_view<W: Write>(
 fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result<()> {
     if !format.is_writable() {
         return Err(Error::InvalidArgument(format!(
-            ".{} is an input format for linear surfaces; write .msh, .vtu, .vtk or .mesh",
+            "cannot write the .{} extension: it is an input format for linear surfaces; write .msh, .vtu, .vtk or .mesh",
             format.extension()
         )));
     }

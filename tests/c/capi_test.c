@@ -491,6 +491,38 @@ static void test_errors_with_mesh(const curvetet_surface *s, const curvetet_mesh
     free(vtk);
 }
 
+/* A linear octahedron (outward) curved by curvetet_surface_from_linear, then meshed. */
+static void test_from_linear(void) {
+    const double xyz[] = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+    const uint32_t tri[] = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4,
+                            2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+    curvetet_surface *s = NULL;
+    CHECK(curvetet_surface_from_linear(xyz, 6, tri, 8, NULL, 40.0, &s) == CURVETET_OK);
+    CHECK(s != NULL);
+    if (!s)
+        return;
+    CHECK(curvetet_surface_num_triangles(s) == 8);
+    CHECK(curvetet_surface_num_nodes(s) == 6 + 12); /* corners kept, one mid node per edge */
+    CHECK(memcmp(curvetet_surface_nodes(s), xyz, sizeof xyz) == 0);
+    curvetet_mesh *m = NULL;
+    CHECK(curvetet_generate(s, NULL, &m) == CURVETET_OK);
+    if (m) {
+        curvetet_quality q = {.struct_size = sizeof q};
+        CHECK(curvetet_mesh_quality(m, &q) == CURVETET_OK);
+        CHECK(q.num_tets > 0 && q.num_invalid == 0);
+    }
+    curvetet_mesh_free(m);
+    curvetet_surface_free(s);
+    /* An open surface (one facet missing) is refused with the specific defect. */
+    s = NULL;
+    CHECK(curvetet_surface_from_linear(xyz, 6, tri, 7, NULL, 40.0, &s) ==
+          CURVETET_ERR_INVALID_SURFACE);
+    CHECK(s == NULL);
+    CHECK(strstr(curvetet_last_error_message(), "not-closed") != NULL);
+    CHECK(curvetet_surface_from_linear(NULL, 6, tri, 8, NULL, 40.0, &s) ==
+          CURVETET_ERR_INVALID_ARGUMENT);
+}
+
 static void test_cancel(const curvetet_surface *s, double limit_ms) {
     curvetet_options o;
     curvetet_options_default(&o);
@@ -537,6 +569,7 @@ int main(int argc, char **argv) {
     test_version_and_names();
     test_options();
     test_errors_without_mesh();
+    test_from_linear();
 
     /* The sphere, read from its file. */
     char *sphere = join_path(g_data, "sphere_p2.msh");

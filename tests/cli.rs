@@ -1,0 +1,171 @@
+//! The command-line tool as a user runs it: `check` accepts the data surfaces (with the
+//! README's V_p2) and rejects every bad-input file with its specific defect and exit code;
+//! `demo` writes a surface `check` accepts and a mesh `check` certifies; `mesh` writes a
+//! mesh `check` certifies; bad options are clear errors.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::time::{Duration, Instant};
+
+fn bin() -> &'static str {
+    env!("CARGO_BIN_EXE_curvetet")
+}
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(bin())
+        .args(args)
+        .output()
+        .expect("curvetet runs")
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("curvetet-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+#[test]
+fn check_accepts_data_surfaces_with_readme_volumes() {
+    for (name, v_p2) in [
+        ("sphere", 4.188659268),
+        ("torus", 2.417959847),
+        ("tube", 4.71240098),
+        ("lv", 3234.7592),
+        ("screw", 3787.149008),
+        ("hinge", 6336.122621),
+    ] {
+        let out = run(&[
+            "check",
+            data(&format!("{name}_p2.msh")).to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let v = j["enclosed_volume"].as_f64().unwrap();
+        // The README gives V_p2 to ~10 significant digits.
+        assert!(
+            (v - v_p2).abs() <= 2e-9 * v_p2.abs().max(1.0),
+            "{name}: {v} vs {v_p2}"
+        );
+    }
+}
+
+#[test]
+fn check_rejects_each_bad_file_with_its_defect() {
+    let list = std::fs::read_to_string(data("bad/EXPECTED.txt")).unwrap();
+    let mut n = 0;
+    for line in list
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+    {
+        let mut it = line.split_whitespace();
+        let (file, kind) = (it.next().unwrap(), it.next().unwrap());
+        let path = data(&format!("bad/{file}"));
+        let t = Instant::now();
+        let out = run(&["check", path.to_str().unwrap()]);
+        assert!(t.elapsed() < Duration::from_secs(10), "{file}: too slow");
+        let code = out
+            .status
+            .code()
+            .expect("exit code, not a signal (no crash)");
+        let err = String::from_utf8_lossy(&out.stderr);
+        // Surface defects exit 4; defects visible in the file text itself are parse errors (3).
+        assert!(code == 4 || code == 3, "{file}: exit {code}: {err}");
+        if code == 4 {
+            assert!(err.contains(kind), "{file}: expected {kind}, got: {err}");
+        }
+        n += 1;
+    }
+    assert!(n >= 30, "corpus has {n} files");
+}
+
+#[test]
+fn demo_and_mesh_write_files_check_certifies() {
+    let surf = tmp("demo_surface.msh");
+    let out = run(&["demo", "--surface-only", "-o", surf.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(run(&["check", surf.to_str().unwrap()]).status.success());
+
+    let vol = tmp("demo_volume.msh");
+    let out = run(&["demo", "-q", "-o", vol.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = run(&["check", vol.to_str().unwrap(), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["valid"], true);
+    assert_eq!(j["report"]["num_invalid"], 0);
+
+    let m = tmp("sphere.vtu");
+    let report = tmp("sphere.json");
+    let out = run(&[
+        "mesh",
+        data("sphere_p2.msh").to_str().unwrap(),
+        "-o",
+        m.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(run(&["check", m.to_str().unwrap()]).status.success());
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert!(r["report"]["num_tets"].as_u64().unwrap() > 1000);
+}
+
+#[test]
+fn bad_options_and_missing_files_fail_clearly() {
+    let s = data("sphere_p2.msh");
+    let o = tmp("x.msh");
+    let out = run(&[
+        "mesh",
+        s.to_str().unwrap(),
+        "-o",
+        o.to_str().unwrap(),
+        "--alpha",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("alpha"));
+    let out = run(&[
+        "mesh",
+        s.to_str().unwrap(),
+        "-o",
+        o.to_str().unwrap(),
+        "--size",
+        "NaN",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let out = run(&[
+        "check",
+        Path::new("/nonexistent/surface.msh").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/surface.msh"));
+}
