@@ -1,7 +1,8 @@
 //! The command-line tool as a user runs it: `check` accepts the data surfaces (with the
 //! README's V_p2) and rejects every bad-input file with its specific defect and exit code;
 //! `demo` writes a surface `check` accepts and a mesh `check` certifies; `mesh` writes a
-//! mesh `check` certifies; bad options are clear errors.
+//! mesh `check` certifies, draws the quality histograms (`--plot`) and skips optimization
+//! with `--no-optimize`; bad options are clear errors.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -168,4 +169,53 @@ fn bad_options_and_missing_files_fail_clearly() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/surface.msh"));
+}
+
+#[test]
+fn mesh_plots_the_two_histograms_and_optimization_can_be_turned_off() {
+    let s = data("sphere_p2.msh");
+    let mesh_with = |name: &str, extra: &[&str]| -> serde_json::Value {
+        let o = tmp(&format!("{name}.msh"));
+        let report = tmp(&format!("{name}.json"));
+        let mut args = vec![
+            "mesh",
+            s.to_str().unwrap(),
+            "-o",
+            o.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "-q",
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+    };
+    let svg = tmp("quality.svg");
+    let opt = mesh_with("opt", &["--plot", svg.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.trim_end().ends_with("</svg>"));
+    assert!(text.contains("Scaled Jacobian min J / max J"));
+    assert!(text.contains("Equiangular skewness"));
+    // Bars in both panels: at least one filled rectangle per histogram bin drawn.
+    assert!(text.matches("<rect").count() > 10, "{text}");
+
+    let raw = mesh_with("raw", &["--no-optimize"]);
+    assert!(opt["times"]["optimize"].as_f64().unwrap() > 0.0);
+    assert!(opt["optimize"]["linear"]["passes"].as_u64().unwrap() > 0);
+    assert_eq!(raw["times"]["optimize"].as_f64(), Some(0.0));
+    assert_eq!(raw["optimize"]["linear"]["passes"].as_u64(), Some(0));
+    let sj = |v: &serde_json::Value| {
+        v["report"]["quality"]["scaled_jacobian_certified"]["min"]
+            .as_f64()
+            .unwrap()
+    };
+    let skew = |v: &serde_json::Value| v["report"]["quality"]["skewness"]["max"].as_f64().unwrap();
+    assert!(sj(&opt) > sj(&raw), "{} vs {}", sj(&opt), sj(&raw));
+    assert!(skew(&opt) < skew(&raw), "{} vs {}", skew(&opt), skew(&raw));
+    assert!(sj(&opt) >= 0.8 && skew(&opt) <= 0.85);
 }

@@ -439,6 +439,7 @@ pub unsafe extern "C" fn curvetet_mesh_report_json(m: *const curvetet_mesh) -> *
                 "report": g.report,
                 "front": g.front,
                 "times": g.times,
+                "optimize": g.optimize,
             });
             // serde_json escapes control characters, so the text has no NUL.
             CString::new(v.to_string()).unwrap_or_default()

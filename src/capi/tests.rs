@@ -337,6 +337,23 @@ fn generate_through_the_abi() {
     assert_eq!(v["report"]["num_tets"].as_u64(), Some(n as u64));
     // Same pointer on the second call (owned by the mesh).
     assert_eq!(json.as_ptr(), unsafe { curvetet_mesh_report_json(m) });
+    // Optimization is on by default: it ran, and its time is part of the stage times.
+    assert!(v["optimize"]["linear"]["passes"].as_u64().unwrap() > 0);
+    assert!(v["times"]["optimize"].as_f64().unwrap() > 0.0);
+    let sj_optimized = g.report.quality.scaled_jacobian_certified.min;
+
+    // `optimize = 0` is honoured: no optimization, and the raw front mesh is worse.
+    let mut o = curvetet_options::defaults();
+    o.optimize = 0;
+    let mut raw = null_mut();
+    assert_eq!(unsafe { curvetet_generate(s, &o, &mut raw) }, CURVETET_OK);
+    let rg = unsafe { &(*raw).generated };
+    assert_eq!(rg.optimize.linear.passes, 0);
+    assert_eq!(rg.times.optimize, 0.0);
+    assert!(rg.report.quality.scaled_jacobian_certified.min < sj_optimized);
+    // The boundary is the same either way.
+    assert_eq!(rg.mesh.boundary, g.mesh.boundary);
+    unsafe { curvetet_mesh_free(raw) };
 
     let bad = CString::new("/nonexistent-dir/x.msh").unwrap();
     assert_eq!(

@@ -276,7 +276,7 @@ mod tests {
 
     #[test]
     fn fast_ln_matches_ln() {
-        let mut x = 1e-300;
+        let mut x = 1e-300_f64;
         while x < 1e300 {
             for f in [1.0, 1.1, 1.3, 1.414, 1.4143, 1.7, 1.99] {
                 let v = x * f;
