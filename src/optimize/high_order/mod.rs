@@ -47,6 +47,10 @@ pub struct HighOrderParams {
     pub rounds: usize,
     /// Let interior vertices move too (their edges' mid nodes follow them).
     pub move_vertices: bool,
+    /// Vertices move only in a patch whose min J / max J after moving the mid nodes is
+    /// still below this (moving them costs more and rarely helps a patch that is nearly
+    /// good enough).
+    pub vertices_below: f64,
     /// Largest corner skewness moving vertices may create (a patch already worse may
     /// not get worse).
     pub max_skewness: f64,
@@ -71,6 +75,7 @@ impl Default for HighOrderParams {
             max_layers: 2,
             rounds: 5,
             move_vertices: true,
+            vertices_below: 0.7,
             max_skewness: 0.7,
             max_skewness_rescue: 0.8,
             rescue_below: 0.5,
@@ -386,7 +391,7 @@ fn optimize_patch(
     }
     // Stage B: vertices too.
     let has_vertex = elems.iter().any(|e| e.var[..4].iter().any(|&i| i != FIXED));
-    if prm.move_vertices && has_vertex && best_min < prm.threshold {
+    if prm.move_vertices && has_vertex && best_min < prm.threshold.min(prm.vertices_below) {
         let vb = v.clone();
         work += run_barrier(&elems, &mut v, h, prm, lb);
         if v != vb {
@@ -638,6 +643,7 @@ mod stress {
             max_layers: env("MAXLAYERS", d.max_layers as f64) as usize,
             rounds: env("ROUNDS", d.rounds as f64) as usize,
             move_vertices: env("MV", 1.0) > 0.0,
+            vertices_below: env("VB", d.vertices_below),
             max_skewness: env("MAXSKEW", d.max_skewness),
             max_skewness_rescue: env("MAXSKEWR", d.max_skewness_rescue),
             rescue_below: env("RESCUE", d.rescue_below),
