@@ -77,6 +77,7 @@ fn main() {
     let hp = HighOrderParams {
         threshold: env("TH", d.threshold),
         reach: env("REACH", d.reach),
+        reach_below: env("REACHB", d.reach_below),
         layers: env("LAYERS", d.layers as f64) as usize,
         max_layers: env("MAXLAYERS", d.max_layers as f64) as usize,
         rounds: env("ROUNDS", d.rounds as f64) as usize,
@@ -87,6 +88,7 @@ fn main() {
         rescue_below: env("RESCUE", d.rescue_below),
         barrier_updates: env("BAR", d.barrier_updates as f64) as usize,
         iterations: env("IT", d.iterations as f64) as usize,
+        stop_slack: env("SLACK", d.stop_slack),
     };
     let it = env("DIFF", 0.0) as usize;
     if it > 0 {

@@ -26,9 +26,6 @@ use objective::{nodes, Objective, PatchElem, FIXED};
 use patch::{colour, Marks, NodeElems, Patch};
 use rayon::prelude::*;
 
-/// How far above the threshold an L-BFGS run may stop early.
-const STOP_SLACK: f64 = 0.03;
-
 /// Tuning of the high-order stage.
 #[derive(Clone, Debug)]
 pub struct HighOrderParams {
@@ -38,6 +35,9 @@ pub struct HighOrderParams {
     /// threshold is min(threshold, max(worst, 0) + reach)): effort goes to the worst
     /// first, and to every invalid element while some are left.
     pub reach: f64,
+    /// When the worst element is at least this good at the start, every round aims at
+    /// the threshold directly (staging only pays where some element is poor).
+    pub reach_below: f64,
     /// Vertex-neighbour rings around a seed in its patch (round r uses
     /// `min(layers + r, max_layers)`).
     pub layers: usize,
@@ -64,6 +64,10 @@ pub struct HighOrderParams {
     pub barrier_updates: usize,
     /// L-BFGS iterations per barrier.
     pub iterations: usize,
+    /// An L-BFGS run stops once every element of its patch is this far above the
+    /// threshold (so that the neighbours' later patches do not push them straight back
+    /// below it).
+    pub stop_slack: f64,
 }
 
 impl Default for HighOrderParams {
@@ -71,6 +75,7 @@ impl Default for HighOrderParams {
         HighOrderParams {
             threshold: 0.85,
             reach: 0.2,
+            reach_below: 0.35,
             layers: 1,
             max_layers: 2,
             rounds: 5,
@@ -81,6 +86,7 @@ impl Default for HighOrderParams {
             rescue_below: 0.5,
             barrier_updates: 3,
             iterations: 6,
+            stop_slack: 0.03,
         }
     }
 }
@@ -140,10 +146,15 @@ pub fn optimize_high_order(
     st.below_threshold[0] = b0;
     let adj = NodeElems::new(mesh);
     let mut marks = Marks::new(ne, mesh.nodes.len());
+    let direct = m0 >= prm.reach_below;
     for round in 0..prm.rounds {
         let worst = sj.iter().copied().fold(f64::INFINITY, f64::min);
         let rp = HighOrderParams {
-            threshold: prm.threshold.min(worst.max(0.0) + prm.reach),
+            threshold: if direct {
+                prm.threshold
+            } else {
+                prm.threshold.min(worst.max(0.0) + prm.reach)
+            },
             ..prm.clone()
         };
         let prm = &rp;
@@ -278,9 +289,7 @@ fn run_barrier(
             evals += elems.len() as u64;
             obj.eval(v, g)
         };
-        // Stop a little above the threshold, so that the neighbours' later patches do
-        // not push these elements straight back below it.
-        let target = prm.threshold + STOP_SLACK;
+        let target = prm.threshold + prm.stop_slack;
         let mut reached = || last.get() >= target;
         lb.minimize(v, &mut f, prm.iterations, 0.02 * h, &mut reached);
         let (new, ratio) = obj.min_measure(v);
@@ -639,6 +648,7 @@ mod stress {
         let hp = HighOrderParams {
             threshold: env("TH", d.threshold),
             reach: env("REACH", d.reach),
+            reach_below: env("REACHB", d.reach_below),
             layers: env("LAYERS", d.layers as f64) as usize,
             max_layers: env("MAXLAYERS", d.max_layers as f64) as usize,
             rounds: env("ROUNDS", d.rounds as f64) as usize,
@@ -649,6 +659,7 @@ mod stress {
             rescue_below: env("RESCUE", d.rescue_below),
             barrier_updates: env("BAR", d.barrier_updates as f64) as usize,
             iterations: env("IT", d.iterations as f64) as usize,
+            stop_slack: env("SLACK", d.stop_slack),
         };
         let t = std::time::Instant::now();
         let st = optimize_high_order(&mut m, &bnd, &hp);
