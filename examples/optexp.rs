@@ -90,19 +90,6 @@ fn main() {
         iterations: env("IT", d.iterations as f64) as usize,
         stop_slack: env("SLACK", d.stop_slack),
     };
-    let it = env("DIFF", 0.0) as usize;
-    if it > 0 {
-        let c = cpu();
-        diffuse(&mut mesh, surf.nodes().len(), it, env("DW", 1.0));
-        let r = QualityReport::of(&mesh);
-        println!(
-            "after diffuse ({:.3}s cpu): minSJ {:.4} cert {:.4} invalid {}",
-            cpu() - c,
-            r.quality.scaled_jacobian.min,
-            r.quality.scaled_jacobian_certified.min,
-            r.num_invalid
-        );
-    }
     let hs = optimize_high_order(&mut mesh, &bnd, &hp);
     let th = t.elapsed().as_secs_f64();
     println!("HO wall {th:.3}s cpu {:.3}s", cpu() - c);
@@ -206,68 +193,6 @@ pub fn star_report(mesh: &curvetet::TetMesh, n_surf: usize, t: usize) {
                     "   star tet {s}: bverts {nb} skew {:.3} sj {:.3} dih {:.1}..{:.1}",
                     q.skewness, q.scaled_jacobian_certified, q.min_dihedral, q.max_dihedral
                 );
-            }
-        }
-    }
-}
-
-/// Harmonic-like extension of the boundary mid-node displacements (Jacobi iterations).
-pub fn diffuse(mesh: &mut curvetet::TetMesh, n_surf: usize, iters: usize, w: f64) {
-    use curvetet::geom::shape::TET10_EDGES;
-    let nn = mesh.nodes.len();
-    let mut ends = vec![[u32::MAX; 2]; nn];
-    let mut nb: Vec<Vec<u32>> = vec![Vec::new(); nn];
-    for t in &mesh.tets {
-        for (k, e) in TET10_EDGES.iter().enumerate() {
-            let m = t[4 + k] as usize;
-            ends[m] = [t[e[0]], t[e[1]]];
-            if m >= n_surf {
-                for j in 4..10 {
-                    if j != 4 + k {
-                        nb[m].push(t[j]);
-                    }
-                }
-            }
-        }
-    }
-    let mut d = vec![[0.0f64; 3]; nn];
-    for m in 0..nn {
-        if ends[m][0] != u32::MAX {
-            let [a, b] = ends[m];
-            let (pa, pb) = (mesh.nodes[a as usize], mesh.nodes[b as usize]);
-            for c in 0..3 {
-                d[m][c] = mesh.nodes[m][c] - 0.5 * (pa[c] + pb[c]);
-            }
-        }
-    }
-    for v in nb.iter_mut() {
-        v.sort_unstable();
-        v.dedup();
-    }
-    for _ in 0..iters {
-        let mut nd = d.clone();
-        for m in n_surf..nn {
-            if nb[m].is_empty() {
-                continue;
-            }
-            let mut s = [0.0; 3];
-            for &q in &nb[m] {
-                for c in 0..3 {
-                    s[c] += d[q as usize][c];
-                }
-            }
-            for c in 0..3 {
-                nd[m][c] = w * s[c] / nb[m].len() as f64;
-            }
-        }
-        d = nd;
-    }
-    for m in n_surf..nn {
-        if ends[m][0] != u32::MAX {
-            let [a, b] = ends[m];
-            let (pa, pb) = (mesh.nodes[a as usize], mesh.nodes[b as usize]);
-            for c in 0..3 {
-                mesh.nodes[m][c] = 0.5 * (pa[c] + pb[c]) + d[m][c];
             }
         }
     }
