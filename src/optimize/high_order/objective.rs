@@ -101,12 +101,15 @@ pub(super) fn score(x: &[P3; 10], enough: f64) -> f64 {
 #[inline]
 fn ln_and_recip(x: f64) -> (f64, f64) {
     const LN2: f64 = std::f64::consts::LN_2;
+    // 2^52 + biased exponent, as a float: the exponent without an int → float
+    // conversion (which SSE2 lacks for 64-bit lanes), so that loops over this vectorize.
+    const EXP_BIAS: f64 = 4_503_599_627_370_496.0 + 1023.0;
     let bits = x.to_bits();
-    let mut e = ((bits >> 52) & 0x7ff) as i64 - 1023;
-    let mut m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
-    let big = (m > std::f64::consts::SQRT_2) as i64;
-    m *= 1.0 - 0.5 * big as f64;
-    e += big;
+    let e = f64::from_bits(((bits >> 52) & 0x7ff) | 0x4330_0000_0000_0000) - EXP_BIAS;
+    let m = f64::from_bits((bits & 0x000f_ffff_ffff_ffff) | 0x3ff0_0000_0000_0000);
+    let big = m > std::f64::consts::SQRT_2;
+    let m = if big { 0.5 * m } else { m };
+    let e = if big { e + 1.0 } else { e };
     // 1 / (x (m + 1)) gives both s = (m − 1)/(m + 1) = (m − 1) x q and 1/x = (m + 1) q.
     let q = 1.0 / (x * (m + 1.0));
     let s = (m - 1.0) * x * q;
@@ -116,7 +119,7 @@ fn ln_and_recip(x: f64) -> (f64, f64) {
             + z * (1.0 / 5.0
                 + z * (1.0 / 7.0
                     + z * (1.0 / 9.0 + z * (1.0 / 11.0 + z * (1.0 / 13.0 + z * (1.0 / 15.0)))))));
-    (e as f64 * LN2 + 2.0 * s * p, (m + 1.0) * q)
+    (e * LN2 + 2.0 * s * p, (m + 1.0) * q)
 }
 
 /// The normalization N(μ) and its derivative.
@@ -228,8 +231,13 @@ impl Objective<'_> {
             let mut df = [0.0; 20];
             let mut dm_sum = 0.0;
             let mut part = 0.0;
+            let mut lnr = [0.0; 20];
+            let mut invr = [0.0; 20];
             for s in 0..20 {
-                let (ln_r, inv_r) = ln_and_recip(m[s] - eps);
+                (lnr[s], invr[s]) = ln_and_recip(m[s] - eps);
+            }
+            for s in 0..20 {
+                let (ln_r, inv_r) = (lnr[s], invr[s]);
                 let l = ln_r - lden;
                 part += (m[s] - 1.0) * (m[s] - 1.0) + l * l;
                 let d = 2.0 * ((m[s] - 1.0) + l * inv_r);
