@@ -302,8 +302,15 @@ fn run_barrier(
     evals
 }
 
-/// Scores of `elems` at `v`, their minimum and the largest corner skewness.
-fn evaluate(elems: &[PatchElem], v: &[f64], enough: f64, out: &mut Vec<f64>) -> (f64, f64) {
+/// Scores of `elems` at `v`, their minimum and (when `with_skew`, else 0) the largest
+/// corner skewness.
+fn evaluate(
+    elems: &[PatchElem],
+    v: &[f64],
+    enough: f64,
+    with_skew: bool,
+    out: &mut Vec<f64>,
+) -> (f64, f64) {
     out.clear();
     let mut lo = f64::INFINITY;
     let mut sk = 0.0f64;
@@ -311,7 +318,9 @@ fn evaluate(elems: &[PatchElem], v: &[f64], enough: f64, out: &mut Vec<f64>) -> 
         let xe = nodes(el, v);
         let s = objective::score(&xe, enough);
         lo = lo.min(s);
-        sk = sk.max(skew(&xe));
+        if with_skew {
+            sk = sk.max(skew(&xe));
+        }
         out.push(s);
     }
     (lo, sk)
@@ -337,14 +346,12 @@ fn optimize_patch(
     let mut h = 0.0;
     let mut before_min = f64::INFINITY;
     let mut before_def = 0.0;
-    let mut before_skew = 0.0f64;
     for &e in &p.elems {
         let t = &mesh.tets[e as usize];
         let xe: [P3; 10] = std::array::from_fn(|k| x[t[k] as usize]);
         h += dist(xe[0], xe[1]);
         before_min = before_min.min(sj[e as usize]);
         before_def += (prm.threshold - sj[e as usize]).max(0.0);
-        before_skew = before_skew.max(skew(&xe));
         elems.push(PatchElem::new(xe, t.map(var_of)));
     }
     h /= p.elems.len().max(1) as f64;
@@ -388,7 +395,8 @@ fn optimize_patch(
     // lift still moves a little) and clearly less total shortfall below the threshold,
     // so improving a patch's other bad elements counts too.
     let better = |m: f64, d: f64, bm: f64, bd: f64| m > bm || (m >= bm - 1e-6 && d < bd - 1e-4);
-    let (mut best_min, _) = evaluate(&elems, &v, prm.threshold, &mut scores);
+    // Corners did not move: no skewness to check.
+    let (mut best_min, _) = evaluate(&elems, &v, prm.threshold, false, &mut scores);
     let mut best_def = deficit(&scores);
     let mut best: Option<(Vec<f64>, Vec<f64>)> = None;
     if v != v0 && better(best_min, best_def, before_min, before_def) {
@@ -404,12 +412,14 @@ fn optimize_patch(
         let vb = v.clone();
         work += run_barrier(&elems, &mut v, h, prm, lb);
         if v != vb {
-            let (lo, sk) = evaluate(&elems, &v, prm.threshold, &mut scores);
+            let (lo, sk) = evaluate(&elems, &v, prm.threshold, true, &mut scores);
             let cap = if before_min < prm.rescue_below {
                 prm.max_skewness_rescue
             } else {
                 prm.max_skewness
             };
+            // Corner skewness before (`x` of a patch element holds its starting nodes).
+            let before_skew = elems.iter().map(|e| skew(&e.x)).fold(0.0f64, f64::max);
             if better(lo, deficit(&scores), best_min, best_def) && sk <= before_skew.max(cap) {
                 best = Some((v.clone(), scores.clone()));
             }
