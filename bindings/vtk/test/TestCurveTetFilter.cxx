@@ -194,6 +194,40 @@ double TetJacobian(const double x[10][3], const double pc[3])
   return Det3(J);
 }
 
+// Equiangular skewness of the corner tet (paper eq. 2) from its six dihedral angles, computed
+// here independently of curvetet: max[(tmax - te)/(180 - te), (te - tmin)/te], te = acos(1/3).
+double Skewness(const double x[10][3])
+{
+  const int edges[6][4] = { { 0, 1, 2, 3 }, { 0, 2, 1, 3 }, { 0, 3, 1, 2 }, { 1, 2, 0, 3 },
+    { 1, 3, 0, 2 }, { 2, 3, 0, 1 } };
+  double lo = 180.0, hi = 0.0;
+  for (const auto& e : edges)
+  {
+    const double* a = x[e[0]];
+    double d[3], u[3], v[3];
+    for (int i = 0; i < 3; ++i)
+      d[i] = x[e[1]][i] - a[i];
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    const double* pk = x[e[2]];
+    const double* pl = x[e[3]];
+    const double du = ((pk[0] - a[0]) * d[0] + (pk[1] - a[1]) * d[1] + (pk[2] - a[2]) * d[2]) / dd;
+    const double dv = ((pl[0] - a[0]) * d[0] + (pl[1] - a[1]) * d[1] + (pl[2] - a[2]) * d[2]) / dd;
+    for (int i = 0; i < 3; ++i)
+    {
+      u[i] = pk[i] - a[i] - du * d[i]; // the faces' directions across the edge
+      v[i] = pl[i] - a[i] - dv * d[i];
+    }
+    const double c[3] = { u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+      u[0] * v[1] - u[1] * v[0] };
+    const double angle = std::atan2(std::sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]),
+                           u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) * 180.0 / M_PI;
+    lo = std::min(lo, angle);
+    hi = std::max(hi, angle);
+  }
+  const double te = std::acos(1.0 / 3.0) * 180.0 / M_PI;
+  return std::max((hi - te) / (180.0 - te), (te - lo) / te);
+}
+
 // 4-point Gauss-Legendre on [0, 1].
 const double kGaussX[4] = { 0.5 - 0.5 * 0.8611363115940526, 0.5 - 0.5 * 0.3399810435848563,
   0.5 + 0.5 * 0.3399810435848563, 0.5 + 0.5 * 0.8611363115940526 };
@@ -287,8 +321,8 @@ double CheckVolumeGrid(vtkUnstructuredGrid* g, const char* what)
   if (!sj || !skew || nc == 0)
     return 0.0;
   CHECK(sj->GetNumberOfTuples() == nc && skew->GetNumberOfTuples() == nc);
-  int wrongType = 0, nonPositive = 0, sjMismatch = 0, badRange = 0;
-  double volume = 0.0, minDet = HUGE_VAL, maxSjDiff = 0.0, minSj = 1.0;
+  int wrongType = 0, nonPositive = 0, sjMismatch = 0, skewMismatch = 0, badRange = 0;
+  double volume = 0.0, minDet = HUGE_VAL, maxSjDiff = 0.0, maxSkewDiff = 0.0, minSj = 1.0;
   vtkNew<vtkIdList> ids;
   for (vtkIdType c = 0; c < nc; ++c)
   {
@@ -313,15 +347,21 @@ double CheckVolumeGrid(vtkUnstructuredGrid* g, const char* what)
     maxSjDiff = std::max(maxSjDiff, std::fabs(a - s.sampledSJ));
     if (std::fabs(a - s.sampledSJ) > 1e-9)
       ++sjMismatch;
+    const double k2 = Skewness(x);
+    maxSkewDiff = std::max(maxSkewDiff, std::fabs(k - k2));
+    if (std::fabs(k - k2) > 1e-9)
+      ++skewMismatch;
   }
   std::printf("  %s: %lld points, %lld cells; min det J %.3g; ScaledJacobian min %.4f (VTK's "
-              "evaluation differs by %.2g at most); volume %.12g\n",
+              "evaluation differs by %.2g at most); EquiangularSkewness differs from the "
+              "test's dihedral angles by %.2g at most; volume %.12g\n",
     what, static_cast<long long>(g->GetNumberOfPoints()), static_cast<long long>(nc), minDet,
-    minSj, maxSjDiff, volume);
+    minSj, maxSjDiff, maxSkewDiff, volume);
   CHECK(wrongType == 0);
   CHECK(nonPositive == 0);
   CHECK(badRange == 0);
   CHECK(sjMismatch == 0);
+  CHECK(skewMismatch == 0);
   return volume;
 }
 
@@ -552,16 +592,51 @@ void TestBad(const std::string& off)
   filter->SetInputData(empty);
   ExpectFailure(filter, msgs, "no triangles", "empty polydata");
 
-  // The same filter still works on a good surface.
-  filter->SetInputData(good);
+  // The same filter still works on a good surface, given with an unused point first (the
+  // used points are compacted, in input order) ...
   filter->OptimizeOff();
+  vtkNew<vtkPolyData> extra;
+  vtkNew<vtkPoints> extraPoints;
+  extraPoints->SetDataTypeToDouble();
+  extraPoints->InsertNextPoint(10.0, 10.0, 10.0);
+  for (vtkIdType i = 0; i < good->GetNumberOfPoints(); ++i)
+    extraPoints->InsertNextPoint(good->GetPoint(i));
+  vtkNew<vtkCellArray> shifted;
+  for (vtkIdType c = 0; c < good->GetNumberOfCells(); ++c)
+  {
+    good->GetCellPoints(c, ids);
+    vtkIdType t[3] = { ids->GetId(0) + 1, ids->GetId(1) + 1, ids->GetId(2) + 1 };
+    shifted->InsertNextCell(3, t);
+  }
+  extra->SetPoints(extraPoints);
+  extra->SetPolys(shifted);
+  filter->SetInputData(extra);
   const int before = msgs.errors;
   filter->Update();
   CHECK(msgs.errors == before);
-  CHECK(filter->GetOutput()->GetNumberOfCells() > 0);
   CHECK(std::strlen(filter->GetLastErrorMessage()) == 0);
-  std::printf("  then a closed surface: %lld tets\n",
-    static_cast<long long>(filter->GetOutput()->GetNumberOfCells()));
+  const vtkIdType nTets = filter->GetOutput()->GetNumberOfCells();
+  CHECK(nTets > 0);
+  double p[3];
+  filter->GetOutput()->GetPoint(0, p);
+  CHECK(std::memcmp(p, good->GetPoint(0), sizeof p) == 0);
+
+  // ... and as a vtkUnstructuredGrid of linear triangles: the same mesh.
+  vtkNew<vtkUnstructuredGrid> linear;
+  linear->SetPoints(good->GetPoints());
+  for (vtkIdType c = 0; c < good->GetNumberOfCells(); ++c)
+  {
+    good->GetCellPoints(c, ids);
+    linear->InsertNextCell(VTK_TRIANGLE, ids);
+  }
+  filter->SetInputData(linear);
+  filter->Update();
+  CHECK(msgs.errors == before);
+  CHECK(filter->GetOutput()->GetNumberOfCells() == nTets);
+  CHECK(filter->GetOutput()->GetCellType(0) == VTK_QUADRATIC_TETRA);
+  std::printf("  then a closed surface (polydata with an unused point, grid of triangles): %lld "
+              "tets\n",
+    static_cast<long long>(nTets));
 }
 
 void TestAbort(const std::string& off)
