@@ -45,6 +45,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -515,20 +516,26 @@ void TestP2(const std::string& msh)
   std::printf("  sphere: boundary nodes bit-identical, %zu triangles and tags kept, volume %.10g\n",
     nt, vTets);
 
+  std::ostringstream printed;
+  filter->Print(printed);
+  CHECK(printed.str().find("FeatureAngle: 40") != std::string::npos);
+  CHECK(printed.str().find("BoundaryTagArrayName: BoundaryTag") != std::string::npos);
+
   // Properties reach curvetet: the paper's uniform size gives another mesh.
   const vtkIdType graded = out->GetNumberOfCells();
   filter->UniformSizeOn();
   filter->OptimizeOff();
   filter->Update();
   CHECK(msgs.errors == 0);
-  CHECK(filter->GetOutput()->GetNumberOfCells() > 0);
-  CHECK(filter->GetOutput()->GetNumberOfCells() != graded);
+  const vtkIdType uniform = filter->GetOutput()->GetNumberOfCells();
+  CHECK(uniform > 0 && uniform != graded);
   filter->SetSize(0.5);
   filter->Update();
   const vtkIdType coarse = filter->GetOutput()->GetNumberOfCells();
   CHECK(coarse > 0 && coarse < graded);
-  std::printf("  sizes: graded %lld tets, uniform %s, size 0.5 %lld tets\n",
-    static_cast<long long>(graded), "differs", static_cast<long long>(coarse));
+  std::printf("  sizes: graded %lld tets, uniform (paper's eq. 1) %lld, size 0.5 %lld\n",
+    static_cast<long long>(graded), static_cast<long long>(uniform),
+    static_cast<long long>(coarse));
 }
 
 void ExpectFailure(vtkCurveTetFilter* filter, Messages& msgs, const char* needle, const char* what)
@@ -637,6 +644,26 @@ void TestBad(const std::string& off)
   std::printf("  then a closed surface (polydata with an unused point, grid of triangles): %lld "
               "tets\n",
     static_cast<long long>(nTets));
+
+  // Inside out: meshed, with curvetet's warning through vtkWarningMacro.
+  vtkNew<vtkPolyData> flipped;
+  flipped->SetPoints(good->GetPoints());
+  vtkNew<vtkCellArray> reversed;
+  for (vtkIdType c = 0; c < good->GetNumberOfCells(); ++c)
+  {
+    good->GetCellPoints(c, ids);
+    vtkIdType t[3] = { ids->GetId(0), ids->GetId(2), ids->GetId(1) };
+    reversed->InsertNextCell(3, t);
+  }
+  flipped->SetPolys(reversed);
+  filter->SetInputData(flipped);
+  const int warningsBefore = msgs.warnings;
+  filter->Update();
+  CHECK(msgs.errors == before);
+  CHECK(msgs.warnings == warningsBefore + 1);
+  CHECK(msgs.last.find("flipped") != std::string::npos);
+  CHECK(filter->GetOutput()->GetNumberOfCells() > 0);
+  std::printf("  inside-out surface: meshed, warning \"%s\"\n", msgs.last.c_str());
 }
 
 void TestAbort(const std::string& off)
