@@ -1,5 +1,5 @@
 // Tests of curvetet_gmsh::generate on Gmsh models (ctest: gmsh_cpp_*).
-//   curvetet_gmsh_test torus|two_volumes|failures OUTDIR CURVETET_CLI
+//   curvetet_gmsh_test torus|two_volumes|cavity|failures OUTDIR CURVETET_CLI
 #include "curvetet_gmsh.hpp"
 
 #include <gmsh.h>
@@ -266,6 +266,39 @@ void test_two_volumes() {
   gmsh::finalize();
 }
 
+// One volume with two shells: Gmsh 4.8's oriented boundary gives the cavity's sphere a
+// positive sign; the wrapper must turn it inward. Gmsh's own tools work on the result.
+void test_cavity() {
+  init();
+  gmsh::model::occ::addBox(0, 0, 0, 2, 2, 2);
+  gmsh::model::occ::addSphere(1, 1, 1, 0.5);
+  gmsh::vectorpair out;
+  std::vector<gmsh::vectorpair> map;
+  gmsh::model::occ::cut({{3, 1}}, {{3, 2}}, out, map);
+  gmsh::model::occ::synchronize();
+  surface_mesh_order2(0.25);
+  const auto tris = surface_triangles();
+  curvetet_gmsh::generate();
+  check_volume_mesh("box minus ball", tris);
+  const double v = tet_volume(), exact = 8 - 4.0 / 3.0 * M_PI * 0.125;
+  std::printf("box minus ball: %.9f (exact %.9f)\n", v, exact);
+  CHECK(std::fabs(v - exact) < 1e-4 * exact, "volume %.9f vs %.9f", v, exact);
+  // Jacobians at the nodes and at Gauss points, as Gmsh computes them, are positive.
+  std::string name;
+  int dim, order, nn, np;
+  std::vector<double> pts, local, weights, jac, det, coord;
+  gmsh::model::mesh::getElementProperties(11, name, dim, order, nn, pts, np);
+  gmsh::model::mesh::getIntegrationPoints(11, "Gauss6", local, weights);
+  pts.insert(pts.end(), local.begin(), local.end());
+  gmsh::model::mesh::getJacobians(11, pts, jac, det, coord);
+  CHECK(!det.empty() && *std::min_element(det.begin(), det.end()) > 0, "a Jacobian is not positive");
+  gmsh::model::mesh::optimize("HighOrder");
+  std::vector<int> types;
+  gmsh::model::mesh::getElementTypes(types, 3);
+  CHECK(types == std::vector<int>{11}, "after Gmsh's optimizer: not only type 11");
+  gmsh::finalize();
+}
+
 void expect_failure(const char *what, const char *needle) {
   const std::size_t nodes = all_nodes().size(), elems = count_elements();
   try {
@@ -326,6 +359,14 @@ void test_failures() {
   }
   gmsh::model::mesh::addElementsByType(s, 9, {1, 2, 3}, tri);
   expect_failure("open surface", "CURVETET_ERR_INVALID_SURFACE");
+  gmsh::clear();
+
+  // Already meshed in 3D (by Gmsh).
+  gmsh::model::occ::addSphere(0, 0, 0, 1);
+  gmsh::model::occ::synchronize();
+  gmsh::option::setNumber("Mesh.MeshSizeMax", 0.4);
+  gmsh::model::mesh::generate(3);
+  expect_failure("already meshed", "already has a 3D mesh");
   gmsh::finalize();
 }
 
@@ -333,7 +374,7 @@ void test_failures() {
 
 int main(int argc, char **argv) {
   if (argc != 4) {
-    std::fprintf(stderr, "usage: %s torus|two_volumes|failures OUTDIR CURVETET_CLI\n", argv[0]);
+    std::fprintf(stderr, "usage: %s torus|two_volumes|cavity|failures OUTDIR CURVETET_CLI\n", argv[0]);
     return 2;
   }
   const std::string which = argv[1], out = argv[2], cli = argv[3];
@@ -343,6 +384,8 @@ int main(int argc, char **argv) {
       test_torus(out, cli);
     else if (which == "two_volumes")
       test_two_volumes();
+    else if (which == "cavity")
+      test_cavity();
     else if (which == "failures")
       test_failures();
     else {

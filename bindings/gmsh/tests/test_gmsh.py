@@ -180,6 +180,31 @@ class TestTwoVolumes(GmshCase):
         self.assertAlmostEqual(vb / (4 / 3 * math.pi * rad ** 3), 1.0, delta=2e-3)
 
 
+class TestCavity(GmshCase):
+    def test_box_minus_ball(self):
+        # One volume with two shells: Gmsh 4.8's oriented boundary gives the cavity's
+        # sphere a positive sign; the wrapper must turn it inward.
+        gmsh.model.occ.addBox(0, 0, 0, 2, 2, 2)
+        gmsh.model.occ.addSphere(1, 1, 1, 0.5)
+        gmsh.model.occ.cut([(3, 1)], [(3, 2)])
+        gmsh.model.occ.synchronize()
+        self.assertEqual(len(gmsh.model.getEntities(3)), 1)
+        self.surface_mesh_order2(0.25)
+        tris = surface_triangles()
+        curvetet_gmsh.generate()
+        self.check_volume_mesh(tris)
+        exact = 8 - 4 / 3 * math.pi * 0.5 ** 3
+        self.assertAlmostEqual(tet_volume() / exact, 1.0, delta=1e-4)
+        # Gmsh's own tools work on the result: Jacobians at nodes and Gauss points are
+        # positive; its high-order optimizer runs.
+        _, _, _, _, nodal, _ = gmsh.model.mesh.getElementProperties(11)
+        local, _ = gmsh.model.mesh.getIntegrationPoints(11, "Gauss6")
+        _, dets, _ = gmsh.model.mesh.getJacobians(11, tolist(nodal) + tolist(local))
+        self.assertGreater(min(tolist(dets)), 0)
+        gmsh.model.mesh.optimize("HighOrder")
+        self.assertEqual(tolist(gmsh.model.mesh.getElementTypes(3)), [11])
+
+
 class TestFailures(GmshCase):
     def expect_failure(self, needle):
         n, e = len(all_nodes()), count_elements()
@@ -222,6 +247,13 @@ class TestFailures(GmshCase):
             tri += [f[0] + 1, f[1] + 1, f[2] + 1] + [mid[f[k], f[(k + 1) % 3]] for k in range(3)]
         gmsh.model.mesh.addElementsByType(s, 9, [1, 2, 3], tri)
         self.expect_failure("CURVETET_ERR_INVALID_SURFACE")
+
+    def test_already_meshed(self):
+        gmsh.model.occ.addSphere(0, 0, 0, 1)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 0.4)
+        gmsh.model.mesh.generate(3)
+        self.expect_failure("already has a 3D mesh")
 
     def test_cancel(self):
         gmsh.model.occ.addSphere(0, 0, 0, 1)
