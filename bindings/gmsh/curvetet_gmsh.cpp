@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <regex>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -66,6 +68,7 @@ struct ModelNodes {
 struct Boundary {
   std::vector<std::size_t> tri6; // Gmsh node tags, 6 per triangle
   std::vector<int> entity;       // per triangle: index into `surfaces`
+  std::vector<std::size_t> elements; // per triangle: its Gmsh element tag
   std::vector<int> surfaces;     // surface entity tags
   std::vector<bool> reversed;    // per surface: its triangles are to be reversed
 };
@@ -111,6 +114,7 @@ Boundary gather_boundary(int volume) {
     b.surfaces.push_back(s);
     b.reversed.push_back(f.second < 0);
     b.tri6.insert(b.tri6.end(), nodes.begin(), nodes.end());
+    b.elements.insert(b.elements.end(), elems.begin(), elems.end());
     b.entity.insert(b.entity.end(), elems.size(), e);
   }
   return b;
@@ -198,6 +202,33 @@ void orient(Boundary &b, const ModelNodes &nodes) {
   }
 }
 
+// curvetet's messages name triangles and nodes by their 0-based index in the arrays it was
+// given; say which Gmsh elements and nodes these are.
+std::string in_gmsh_numbers(const std::string &msg, const Boundary &b,
+                            const std::vector<std::size_t> &node_tags) {
+  std::set<std::size_t> tris, nodes;
+  static const std::regex tri_re(R"(triangles? (\d+))"), node_re(R"(nodes? (\d+))"),
+      list_re(R"((corners|edge) \(?(\d+), (\d+)(, (\d+))?)");
+  for (auto it = std::sregex_iterator(msg.begin(), msg.end(), tri_re); it != std::sregex_iterator(); ++it)
+    tris.insert(std::stoul((*it)[1]));
+  for (auto it = std::sregex_iterator(msg.begin(), msg.end(), node_re); it != std::sregex_iterator(); ++it)
+    nodes.insert(std::stoul((*it)[1]));
+  for (auto it = std::sregex_iterator(msg.begin(), msg.end(), list_re); it != std::sregex_iterator(); ++it)
+    for (int g : {2, 3, 5})
+      if ((*it)[g].matched) nodes.insert(std::stoul((*it)[g]));
+  std::string out;
+  int n = 0;
+  for (std::size_t t : tris)
+    if (t < b.elements.size() && n++ < 8)
+      out += (out.empty() ? "" : "; ") + std::string("triangle ") + std::to_string(t) + " = element " +
+             std::to_string(b.elements[t]) + " of surface " + std::to_string(b.surfaces[b.entity[t]]);
+  for (std::size_t i : nodes)
+    if (i < node_tags.size() && n++ < 16)
+      out += (out.empty() ? "" : "; ") + std::string("node ") + std::to_string(i) + " = node " +
+             std::to_string(node_tags[i]);
+  return out.empty() ? "" : " [in Gmsh's numbers: " + out + "]";
+}
+
 Region mesh_volume(int volume, const ModelNodes &nodes, const curvetet_options *opt) {
   Boundary b = gather_boundary(volume);
   if (b.entity.empty()) fail("volume " + std::to_string(volume) + " has an empty boundary mesh");
@@ -234,14 +265,18 @@ Region mesh_volume(int volume, const ModelNodes &nodes, const curvetet_options *
   curvetet_status st = curvetet_surface_from_arrays(xyz.data(), r.boundary_tags.size(), tri6.data(),
                                                     nt, tags.data(), &s);
   SurfacePtr surface(s);
-  if (st != CURVETET_OK)
-    fail("volume " + std::to_string(volume) + ": its boundary surface is not acceptable (" +
-         curvetet_error(st) + "); triangle and node numbers are 0-based in the order of the "
-         "volume's boundary surfaces");
+  if (st != CURVETET_OK) {
+    const std::string msg = curvetet_error(st);
+    fail("volume " + std::to_string(volume) + ": its boundary surface is not acceptable (" + msg + ")" +
+         in_gmsh_numbers(msg, b, r.boundary_tags));
+  }
   curvetet_mesh *m = nullptr;
   st = curvetet_generate(surface.get(), opt, &m);
   r.mesh.reset(m);
-  if (st != CURVETET_OK) fail("volume " + std::to_string(volume) + ": " + curvetet_error(st));
+  if (st != CURVETET_OK) {
+    const std::string msg = curvetet_error(st);
+    fail("volume " + std::to_string(volume) + ": " + msg + in_gmsh_numbers(msg, b, r.boundary_tags));
+  }
   if (curvetet_mesh_num_nodes(m) < r.boundary_tags.size())
     fail("volume " + std::to_string(volume) + ": curvetet returned fewer nodes than the surface has");
   return r;

@@ -20,6 +20,7 @@ import ctypes
 import ctypes.util
 import glob
 import os
+import re
 
 import gmsh
 
@@ -152,7 +153,8 @@ def _fail(msg):
 
 
 def _gather_boundary(volume):
-    """[(surface tag, reversed, [6 node tags per triangle...])] of a volume's boundary."""
+    """[[surface tag, reversed, [6 node tags per triangle...], [element tags]]] of a
+    volume's boundary."""
     if len(gmsh.model.mesh.getElementTypes(3, volume)) > 0:
         _fail("volume %d already has a 3D mesh; clear it (gmsh.model.mesh.clear) or "
               "generate only up to dimension 2" % volume)
@@ -177,8 +179,8 @@ def _gather_boundary(volume):
                       "needs a second-order triangle mesh (6-node triangles, type 9): set "
                       "Mesh.ElementOrder = 2 before generate(2), or call "
                       "gmsh.model.mesh.setOrder(2)" % (s, volume, t, name))
-        _, nodes = gmsh.model.mesh.getElementsByType(TRI6, s)
-        out.append([s, s_signed < 0, _tolist(nodes)])
+        elems, nodes = gmsh.model.mesh.getElementsByType(TRI6, s)
+        out.append([s, s_signed < 0, _tolist(nodes), _tolist(elems)])
     return out
 
 
@@ -237,6 +239,21 @@ def _orient(surfaces, coords):
             surfaces[e][1] = not surfaces[e][1]
 
 
+def _in_gmsh_numbers(msg, surfaces, node_tags):
+    """curvetet's messages name triangles and nodes by their 0-based index in the arrays it
+    was given; say which Gmsh elements and nodes these are."""
+    tris = sorted({int(m) for m in re.findall(r"triangles? (\d+)", msg)})
+    nodes = {int(m) for m in re.findall(r"nodes? (\d+)", msg)}
+    for m in re.finditer(r"(corners|edge) \(?(\d+), (\d+)(, (\d+))?", msg):
+        nodes.update(int(m.group(g)) for g in (2, 3, 5) if m.group(g) is not None)
+    elements = [(e, s[0]) for s in surfaces for e in s[3]]
+    out = ["triangle %d = element %d of surface %d" % ((t,) + elements[t])
+           for t in tris if t < len(elements)][:8]
+    out += ["node %d = node %d" % (i, node_tags[i]) for i in sorted(nodes)
+            if i < len(node_tags)][:16 - len(out)]
+    return " [in Gmsh's numbers: %s]" % "; ".join(out) if out else ""
+
+
 def _mesh_volume(lib, volume, coords, opt):
     """Mesh one volume: (boundary node tags, new node coordinates, tets as local indices)."""
     surfaces = _gather_boundary(volume)
@@ -249,7 +266,7 @@ def _mesh_volume(lib, volume, coords, opt):
     _orient(surfaces, coords)
 
     local, tags_of, xyz, tri6, ttags = {}, [], [], [], []
-    for s_tag, rev, nodes in surfaces:
+    for s_tag, rev, nodes, _ in surfaces:
         idx = _FLIP if rev else range(6)
         for t in range(len(nodes) // 6):
             for k in range(6):
@@ -269,12 +286,13 @@ def _mesh_volume(lib, volume, coords, opt):
         len(ttags), (c.c_int32 * len(ttags))(*ttags), c.byref(surface))
     try:
         if st != 0:
-            _fail("volume %d: its boundary surface is not acceptable (%s); triangle and node "
-                  "numbers are 0-based in the order of the volume's boundary surfaces"
-                  % (volume, _error(lib, st)))
+            msg = _error(lib, st)
+            _fail("volume %d: its boundary surface is not acceptable (%s)%s"
+                  % (volume, msg, _in_gmsh_numbers(msg, surfaces, tags_of)))
         st = lib.curvetet_generate(surface, c.byref(opt), c.byref(mesh))
         if st != 0:
-            _fail("volume %d: %s" % (volume, _error(lib, st)))
+            msg = _error(lib, st)
+            _fail("volume %d: %s%s" % (volume, msg, _in_gmsh_numbers(msg, surfaces, tags_of)))
         nb, nn = len(tags_of), lib.curvetet_mesh_num_nodes(mesh)
         if nn < nb:
             _fail("volume %d: curvetet returned fewer nodes than the surface has" % volume)

@@ -359,6 +359,9 @@ void test_failures() {
   }
   gmsh::model::mesh::addElementsByType(s, 9, {1, 2, 3}, tri);
   expect_failure("open surface", "CURVETET_ERR_INVALID_SURFACE");
+  expect_failure("open surface (Gmsh numbers)",
+                 ("[in Gmsh's numbers: triangle 0 = element 1 of surface " + std::to_string(s) +
+                  "; node 0 = node 1").c_str());
   gmsh::clear();
 
   // Already meshed in 3D (by Gmsh).

@@ -247,6 +247,8 @@ class TestFailures(GmshCase):
             tri += [f[0] + 1, f[1] + 1, f[2] + 1] + [mid[f[k], f[(k + 1) % 3]] for k in range(3)]
         gmsh.model.mesh.addElementsByType(s, 9, [1, 2, 3], tri)
         self.expect_failure("CURVETET_ERR_INVALID_SURFACE")
+        # The message also names the Gmsh element and nodes.
+        self.expect_failure("[in Gmsh's numbers: triangle 0 = element 1 of surface %d; node 0 = node 1" % s)
 
     def test_already_meshed(self):
         gmsh.model.occ.addSphere(0, 0, 0, 1)
