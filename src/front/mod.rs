@@ -583,7 +583,7 @@ impl<'a> Mesher<'a> {
                 0.97,
                 self.opts.min_edge_face_angle_deg / 2.5,
             ),
-            _ => (0.0, 1.0, 0.0),
+            _ => (0.0, 1.0, 1.0),
         };
         let mut cands = std::mem::take(&mut self.cands);
         cands.retain_mut(|cd| {
