@@ -49,7 +49,8 @@ pub struct HighOrderParams {
     pub move_vertices: bool,
     /// Vertices move only in a patch whose min J / max J after moving the mid nodes is
     /// still below this (moving them costs more and rarely helps a patch that is nearly
-    /// good enough).
+    /// good enough), until a round improves nothing: later rounds move them in every
+    /// patch below the threshold.
     pub vertices_below: f64,
     /// Largest corner skewness moving vertices may create (a patch already worse may
     /// not get worse).
@@ -147,9 +148,17 @@ pub fn optimize_high_order(
     let adj = NodeElems::new(mesh);
     let mut marks = Marks::new(ne, mesh.nodes.len());
     let direct = m0 >= prm.reach_below;
+    // Set once a round improved nothing with vertices held back: from then on vertices
+    // may move in every patch below the threshold.
+    let mut escalate = false;
     for round in 0..prm.rounds {
         let worst = sj.iter().copied().fold(f64::INFINITY, f64::min);
         let rp = HighOrderParams {
+            vertices_below: if escalate {
+                prm.threshold
+            } else {
+                prm.vertices_below
+            },
             threshold: if direct {
                 prm.threshold
             } else {
@@ -230,7 +239,10 @@ pub fn optimize_high_order(
             }
         }
         if improved_round == 0 {
-            break;
+            if escalate || prm.vertices_below >= prm.threshold || !prm.move_vertices {
+                break;
+            }
+            escalate = true;
         }
     }
     // Exact scores where a round stored a cheaper lower bound below the threshold.
