@@ -423,7 +423,7 @@ impl<'a> Mesher<'a> {
             }
             // ...else, where remeshing has not helped, accept a tet the optimizer must
             // untangle...
-            if self.repair_count(fid) >= 4 && self.advance(fid, 3) {
+            if self.repair_count(fid) >= 1 && self.advance(fid, 3) {
                 continue;
             }
             // ...else remesh around it.
