@@ -451,7 +451,8 @@ fn reference(name: &str) -> Vec<String> {
                     Err(e) => fail.push(format!("CGAL output: {e}")),
                     Ok(m) => {
                         let mut row = Row::measure("cgal", &m, secs);
-                        match compare::conformity(&m, None) {
+                        // CGAL's cells are right-handed (positive orientation).
+                        match compare::conformity(&m, Some(1)) {
                             Err(e) => fail.push(format!("CGAL conformity: {e}")),
                             Ok(c) => {
                                 // Not a failure: Mesh_3's surface facets (the medit
@@ -464,11 +465,15 @@ fn reference(name: &str) -> Vec<String> {
                                     ));
                                 }
                                 row.volume = row.volume.abs();
+                                row.note = format!(
+                                    "{}-handed tets; ",
+                                    if c.orientation > 0 { "right" } else { "left" }
+                                );
                             }
                         }
                         let tol = cgal_tolerance(area, h);
                         let d = (row.volume - v_lin).abs();
-                        row.note = format!(
+                        row.note += &format!(
                             "|V-V_lin| = {:.1e} rel, tolerance {:.1e}",
                             d / v_lin,
                             tol / v_lin
