@@ -130,8 +130,13 @@ fn run(cmd: &mut Command, dir: &Path) -> Result<Run, String> {
         let e = std::fs::read_to_string(&err).unwrap_or_default();
         let tail: Vec<&str> = e.lines().collect();
         return Err(format!(
-            "{:?} failed (status {status}): {}",
+            "{:?} failed ({}): {}",
             cmd.get_program(),
+            if libc::WIFEXITED(status) {
+                format!("exit code {}", libc::WEXITSTATUS(status))
+            } else {
+                format!("signal {}", libc::WTERMSIG(status))
+            },
             tail[tail.len().saturating_sub(3)..].join(" | ")
         ));
     }
