@@ -180,6 +180,12 @@ typedef struct curvetet_options {
      * Passed to `progress` unchanged; may be NULL.
      */
     void *user_data;
+    /**
+     * Nonzero: when `size` <= 0, use the paper's uniform size (tetrahedron height from
+     * the mean curved triangle area, its eq. 1) instead of grading from the boundary.
+     * Default 0. (Added in 0.1 after the first struct; older callers get the default.)
+     */
+    int32_t uniform_size;
 } curvetet_options;
 
 /**
@@ -386,6 +392,23 @@ enum curvetet_status curvetet_mesh_boundary_faces(const struct curvetet_mesh *m,
  */
 enum curvetet_status curvetet_mesh_quality(const struct curvetet_mesh *m,
                                            struct curvetet_quality *out);
+
+/**
+ * Per-element quality, in the order of `curvetet_mesh_tets`: `scaled_jacobian_out`
+ * receives `curvetet_mesh_num_tets(m)` sampled scaled Jacobians (min J / max J over the
+ * element; 1 for a straight-sided tet), `skewness_out` as many equiangular skewnesses
+ * (paper eq. 2 on the corner tet; 0 best, 1 degenerate). Either may be NULL (not
+ * wanted). Computed on each call (in parallel), so keep the result rather than call
+ * it per element.
+ *
+ * Errors: `CURVETET_ERR_INVALID_ARGUMENT` when `m` is NULL or a buffer is misaligned.
+ *
+ * # Safety
+ * `m` must be a live mesh and each non-NULL buffer hold the count above.
+ */
+enum curvetet_status curvetet_mesh_tet_quality(const struct curvetet_mesh *m,
+                                               double *scaled_jacobian_out,
+                                               double *skewness_out);
 
 /**
  * Write the mesh (tetrahedra and boundary triangles with their tags) to `path`; the

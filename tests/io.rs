@@ -597,7 +597,7 @@ print("meshio ok", len(spec))
 #[test]
 fn meshio_reads_what_we_write() {
     if !has_python_meshio() {
-        println!("note: python3 with meshio not available; skipped (pip install meshio)");
+        skip("python3 with meshio not available; skipped (pip install meshio)");
         return;
     }
     let mesh = curved_mesh();
@@ -657,7 +657,7 @@ fn has_gmsh() -> bool {
 #[test]
 fn gmsh_checks_what_we_write_without_warnings() {
     if !has_gmsh() {
-        println!("note: gmsh not available; skipped");
+        skip("gmsh not available; skipped");
         return;
     }
     let mesh = curved_mesh();
@@ -724,7 +724,7 @@ fn gmsh_checks_what_we_write_without_warnings() {
 #[test]
 fn gmsh_medit_export_matches_our_medit_order() {
     if !has_gmsh() {
-        println!("note: gmsh not available; skipped");
+        skip("gmsh not available; skipped");
         return;
     }
     let mesh = curved_mesh();
@@ -1008,7 +1008,7 @@ fn vtk_reads_what_we_write_and_we_read_what_vtk_writes() {
         .map(|o| o.status.success())
         .unwrap_or(false);
     if !has_vtk {
-        println!("note: python3 with vtk not available; skipped (pip install vtk)");
+        skip("python3 with vtk not available; skipped (pip install vtk)");
         return;
     }
     let mesh = curved_mesh();
@@ -1070,7 +1070,7 @@ meshio.write(outdir + "/mio_a.vtk", m, binary=False)
 #[test]
 fn we_read_what_meshio_writes() {
     if !has_python_meshio() {
-        println!("note: python3 with meshio not available; skipped (pip install meshio)");
+        skip("python3 with meshio not available; skipped (pip install meshio)");
         return;
     }
     let s = io::read(&data("sphere_p2.msh")).unwrap();
@@ -1124,7 +1124,7 @@ fn we_read_what_meshio_writes() {
 #[test]
 fn we_read_what_gmsh_writes() {
     if !has_gmsh() {
-        println!("note: gmsh not available; skipped");
+        skip("gmsh not available; skipped");
         return;
     }
     let dir = out_dir("from_gmsh");
@@ -1246,4 +1246,14 @@ fn empty_mesh_round_trips() {
         let back = read_bytes(&bytes, format, &file).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(back.nodes.is_empty() && back.tri6.is_empty() && back.tet10.is_empty());
     }
+}
+
+/// A check that needs an external tool the test script installs: without it, fail when
+/// `CURVETET_REQUIRE_TOOLS` is set (scripts/test sets it, so CI never skips silently),
+/// else print why it was skipped.
+fn skip(why: &str) {
+    if std::env::var_os("CURVETET_REQUIRE_TOOLS").is_some() {
+        panic!("required tool missing: {why}");
+    }
+    println!("note: {why}");
 }

@@ -7,7 +7,7 @@ use super::status::{curvetet_status, CURVETET_ERR_CANCELLED};
 use super::surface::{c_path, curvetet_surface, reset_out};
 use crate::io::order::{tet10_to, Convention};
 use crate::io::{MshVersion, WriteOptions};
-use crate::mesh::quality::QualityReport;
+use crate::mesh::quality::{element_qualities, QualityReport};
 use crate::{generate_with_progress, Error, Generated};
 use std::ffi::{c_char, c_int, CString};
 use std::mem::{offset_of, size_of};
@@ -349,6 +349,46 @@ pub unsafe extern "C" fn curvetet_mesh_quality(
         put!(max_dihedral_deg);
         // SAFETY: as above.
         unsafe { std::ptr::addr_of_mut!((*out).struct_size).write(filled as u32) };
+        Ok(())
+    })
+}
+
+/// Per-element quality, in the order of `curvetet_mesh_tets`: `scaled_jacobian_out`
+/// receives `curvetet_mesh_num_tets(m)` sampled scaled Jacobians (min J / max J over the
+/// element; 1 for a straight-sided tet), `skewness_out` as many equiangular skewnesses
+/// (paper eq. 2 on the corner tet; 0 best, 1 degenerate). Either may be NULL (not
+/// wanted). Computed on each call (in parallel), so keep the result rather than call
+/// it per element.
+///
+/// Errors: `CURVETET_ERR_INVALID_ARGUMENT` when `m` is NULL or a buffer is misaligned.
+///
+/// # Safety
+/// `m` must be a live mesh and each non-NULL buffer hold the count above.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_mesh_tet_quality(
+    m: *const curvetet_mesh,
+    scaled_jacobian_out: *mut f64,
+    skewness_out: *mut f64,
+) -> curvetet_status {
+    status_call("curvetet_mesh_tet_quality", || {
+        // SAFETY: live by contract.
+        let m = unsafe { deref(m, "m")? };
+        if scaled_jacobian_out.is_null() && skewness_out.is_null() {
+            return Ok(());
+        }
+        let q = element_qualities(&m.generated.mesh);
+        // SAFETY: each non-NULL buffer holds num_tets elements by contract; alignment
+        // is checked inside.
+        unsafe {
+            if !scaled_jacobian_out.is_null() {
+                let sj: Vec<f64> = q.iter().map(|e| e.scaled_jacobian).collect();
+                copy_out(&sj, scaled_jacobian_out, "scaled_jacobian_out")?;
+            }
+            if !skewness_out.is_null() {
+                let sk: Vec<f64> = q.iter().map(|e| e.skewness).collect();
+                copy_out(&sk, skewness_out, "skewness_out")?;
+            }
+        }
         Ok(())
     })
 }

@@ -47,6 +47,10 @@ pub struct curvetet_options {
     pub progress: curvetet_progress_fn,
     /// Passed to `progress` unchanged; may be NULL.
     pub user_data: *mut c_void,
+    /// Nonzero: when `size` <= 0, use the paper's uniform size (tetrahedron height from
+    /// the mean curved triangle area, its eq. 1) instead of grading from the boundary.
+    /// Default 0. (Added in 0.1 after the first struct; older callers get the default.)
+    pub uniform_size: i32,
 }
 
 /// `sizeof(curvetet_options)` of the first version of the ABI (curvetet 0.1): every
@@ -69,6 +73,7 @@ impl curvetet_options {
             threads: d.threads as u32,
             progress: None,
             user_data: std::ptr::null_mut(),
+            uniform_size: 0,
         }
     }
 }
@@ -139,6 +144,7 @@ pub(crate) unsafe fn parse(p: *const curvetet_options) -> Result<Parsed> {
         take!(threads);
         take!(progress);
         take!(user_data);
+        take!(uniform_size);
     }
     let mut options = Options {
         alpha: o.alpha,
@@ -148,6 +154,8 @@ pub(crate) unsafe fn parse(p: *const curvetet_options) -> Result<Parsed> {
     };
     options.size = if o.size.is_nan() || o.size > 0.0 {
         SizeMode::Fixed(o.size) // NaN and infinity are rejected by validate()
+    } else if o.uniform_size != 0 {
+        SizeMode::Uniform
     } else {
         SizeMode::Graded
     };

@@ -104,11 +104,33 @@ fn options_struct_size_is_checked() {
         o.struct_size as usize,
         std::mem::size_of::<curvetet_options>()
     );
-    assert_eq!(o.struct_size as usize, OPTIONS_SIZE_V1);
+    assert!(o.struct_size as usize > OPTIONS_SIZE_V1);
     let p = unsafe { parse(&o) }.unwrap();
     assert_eq!(p.options.alpha, 1.5);
     assert!(p.options.optimize);
     assert_eq!(p.options.size, SizeMode::Graded);
+    assert!(unsafe { parse(null()) }.is_ok());
+
+    // uniform_size picks the paper's size when no size is given; a given size wins.
+    let mut u = o;
+    u.uniform_size = 1;
+    assert_eq!(
+        unsafe { parse(&u) }.unwrap().options.size,
+        SizeMode::Uniform
+    );
+    u.size = 0.5;
+    assert_eq!(
+        unsafe { parse(&u) }.unwrap().options.size,
+        SizeMode::Fixed(0.5)
+    );
+    // A first-version struct (without uniform_size) is read up to its size only.
+    let mut v1 = o;
+    v1.uniform_size = 1;
+    v1.struct_size = OPTIONS_SIZE_V1 as u32;
+    assert_eq!(
+        unsafe { parse(&v1) }.unwrap().options.size,
+        SizeMode::Graded
+    );
     assert!(unsafe { parse(null()) }.is_ok());
 
     for bad in [

@@ -206,6 +206,29 @@ static void check_mesh(const curvetet_mesh *m, const arrays *sa) {
     CHECK(json == curvetet_mesh_report_json(m)); /* owned by the mesh, made once */
     CHECK(curvetet_mesh_target_size(m) > 0.0);
 
+    /* Per-element quality: agrees with the report's extremes. */
+    double *sj = (double *)xmalloc(nt * sizeof(double));
+    double *skew = (double *)xmalloc(nt * sizeof(double));
+    EXPECT_STATUS(curvetet_mesh_tet_quality(m, sj, skew), CURVETET_OK);
+    double sj_min = 2.0, skew_max = -1.0;
+    for (size_t t = 0; t < nt; t++) {
+        CHECK(sj[t] > 0.0 && sj[t] <= 1.0);
+        CHECK(skew[t] >= 0.0 && skew[t] < 1.0);
+        if (sj[t] < sj_min) sj_min = sj[t];
+        if (skew[t] > skew_max) skew_max = skew[t];
+    }
+    CHECK(sj_min == q.min_scaled_jacobian);
+    CHECK(skew_max == q.max_skewness);
+    double *sj2 = (double *)xmalloc(nt * sizeof(double));
+    EXPECT_STATUS(curvetet_mesh_tet_quality(m, sj2, NULL), CURVETET_OK);
+    CHECK(memcmp(sj, sj2, nt * sizeof(double)) == 0);
+    EXPECT_STATUS(curvetet_mesh_tet_quality(m, NULL, NULL), CURVETET_OK);
+    EXPECT_STATUS(curvetet_mesh_tet_quality(NULL, sj, skew), CURVETET_ERR_INVALID_ARGUMENT);
+    EXPECT_MESSAGE("m is NULL");
+    free(sj);
+    free(sj2);
+    free(skew);
+
     printf("  mesh: %zu nodes, %zu tets, %zu boundary faces; SJ min %.3f (certified %.3f) "
            "mean %.3f; skewness max %.3f; dihedral %.1f..%.1f deg\n",
            nn, nt, nb, q.min_scaled_jacobian, q.min_scaled_jacobian_certified,
@@ -286,6 +309,7 @@ static void test_options(void) {
     CHECK(o.optimize == 1);
     CHECK(o.threads == 0);
     CHECK(o.progress == NULL && o.user_data == NULL);
+    CHECK(o.uniform_size == 0);
     curvetet_options p;
     memset(&p, 0xAB, sizeof p);
     EXPECT_STATUS(curvetet_options_init(&p, sizeof p), CURVETET_OK);
@@ -434,6 +458,27 @@ static void test_errors_without_mesh(void) {
     free(noext);
     free(sphere);
     free(expected);
+}
+
+/* uniform_size: the paper's uniform size (eq. 1) instead of the graded one; an explicit
+ * size still wins. */
+static void test_uniform_size(const curvetet_surface *s, double graded_size) {
+    curvetet_options o;
+    curvetet_options_default(&o);
+    o.uniform_size = 1;
+    o.optimize = 0;
+    curvetet_mesh *u = NULL;
+    EXPECT_STATUS(curvetet_generate(s, &o, &u), CURVETET_OK);
+    REQUIRE(u != NULL);
+    double hu = curvetet_mesh_target_size(u);
+    CHECK(hu > 0.0 && hu != graded_size);
+    CHECK(curvetet_mesh_num_tets(u) > 0);
+    curvetet_mesh_free(u);
+    o.size = 0.75 * hu;
+    EXPECT_STATUS(curvetet_generate(s, &o, &u), CURVETET_OK);
+    REQUIRE(u != NULL);
+    CHECK(curvetet_mesh_target_size(u) == 0.75 * hu);
+    curvetet_mesh_free(u);
 }
 
 static void test_errors_with_mesh(const curvetet_surface *s, const curvetet_mesh *m) {
@@ -646,6 +691,7 @@ int main(int argc, char **argv) {
     }
 
     test_errors_with_mesh(s, m);
+    test_uniform_size(s, curvetet_mesh_target_size(m));
     test_cancel(s, cancel_ms);
 
     /* The surface outlives nothing: meshes stay valid after it is freed. */

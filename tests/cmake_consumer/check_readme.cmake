@@ -1,10 +1,13 @@
 # ctest: the README's C example is exactly tests/cmake_consumer/mesh_surface.c (which the
 # consumer tests compile and run), so the documented example is a compiled one.
-#   cmake -DREADME=... -DEXAMPLE=... -P check_readme.cmake
+#   cmake -DREADME=... -DEXAMPLE=... [-DLANG=cpp] -P check_readme.cmake
+if(NOT DEFINED LANG)
+  set(LANG c)
+endif()
 file(READ "${README}" readme)
 file(READ "${EXAMPLE}" example)
-string(FIND "${readme}" "```c\n${example}```" pos)
+string(FIND "${readme}" "```${LANG}\n${example}```" pos)
 if(pos EQUAL -1)
   message(FATAL_ERROR "README.md's C example differs from ${EXAMPLE}; paste the file into "
-                      "the README's ```c block")
+                      "the README's ```${LANG} block")
 endif()

@@ -1,9 +1,15 @@
 # ctest fixture: install the build tree into a fresh PREFIX and check the layout.
-#   cmake -DBUILD_DIR=... -DPREFIX=... -DLIBDIR=lib -DSONAME=libcurvetet.so.X -P install_prefix.cmake
+#   cmake -DBUILD_DIR=... -DPREFIX=... -DLIBDIR=lib -DSONAME=libcurvetet.so.X [-DVTK=ON]
+#         -P install_prefix.cmake
 file(REMOVE_RECURSE "${PREFIX}")
 execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${PREFIX}"
                 OUTPUT_QUIET COMMAND_ERROR_IS_FATAL ANY)
-foreach(f
+set(_vtk_files "")
+if(VTK)
+  set(_vtk_files "${LIBDIR}/libcurvetet_vtk.so" "include/vtkCurveTetFilter.h"
+                 "${LIBDIR}/cmake/CurveTet/CurveTetVTKTargets.cmake")
+endif()
+foreach(f ${_vtk_files}
     "${LIBDIR}/libcurvetet.a"
     "${LIBDIR}/${SONAME}"
     "${LIBDIR}/libcurvetet.so"
