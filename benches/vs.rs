@@ -9,8 +9,8 @@
 //! - curvetet: `curvetet mesh IN_p2.msh -o OUT.msh --threads T` — end to end: read, mesh,
 //!   optimize, certify, write (T = `--threads`, default 1: the targets are per core);
 //! - TetGen:   `tetgen -pYqQ IN_lin.off` (quality mesh, boundary kept), the linear twin;
-//! - Gmsh:     when a Python with the `gmsh` module is found (python3, /usr/bin/python3, or
-//!   $CURVETET_BENCH_PYTHON): merge the linear twin (STL), HXT 3D (Mesh.Algorithm3D = 10,
+//! - Gmsh:     when a Python with the `gmsh` module is found ($CURVETET_BENCH_PYTHON, the
+//!   PyPI gmsh 4.15 venv of scripts/install-deps, python3, /usr/bin/python3): merge the linear twin (STL), HXT 3D (Mesh.Algorithm3D = 10,
 //!   one thread), setOrder(2), write .msh; its time is measured inside the script (merge to
 //!   write, Python start-up excluded), its memory includes the Python interpreter.
 //!
@@ -187,19 +187,31 @@ fn measure(runs: usize, mut once: impl FnMut() -> Result<(f64, u64, usize), Stri
     s
 }
 
-fn python_with_gmsh() -> Option<String> {
+/// The first Python that imports `gmsh`, with the module's version: $CURVETET_BENCH_PYTHON,
+/// then the PyPI gmsh venv scripts/install-deps makes (Gmsh 4.15, the reference
+/// version), then the system's python3-gmsh (4.8).
+fn python_with_gmsh() -> Option<(String, String)> {
     let mut c: Vec<String> = Vec::new();
     if let Ok(p) = std::env::var("CURVETET_BENCH_PYTHON") {
         c.push(p);
     }
+    let venv = std::env::var("CURVETET_PYPI_GMSH_VENV").unwrap_or_else(|_| {
+        format!(
+            "{}/.cache/curvetet/pypi-gmsh",
+            std::env::var("HOME").unwrap_or_default()
+        )
+    });
+    c.push(format!("{venv}/bin/python"));
     c.extend(["python3".into(), "/usr/bin/python3".into()]);
-    c.into_iter().find(|p| {
-        Command::new(p)
-            .args(["-c", "import gmsh"])
-            .stdout(Stdio::null())
+    c.into_iter().find_map(|p| {
+        let o = Command::new(&p)
+            .args(["-c", "import gmsh; print(gmsh.__version__)"])
             .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success())
+            .output()
+            .ok()?;
+        o.status
+            .success()
+            .then(|| (p, String::from_utf8_lossy(&o.stdout).trim().to_string()))
     })
 }
 
@@ -268,9 +280,9 @@ fn main() {
         } else {
             "NOT FOUND (apt-get install tetgen)"
         },
-        python.as_deref().map_or(
+        python.as_ref().map_or(
             "NOT FOUND (apt-get install python3-gmsh)".to_string(),
-            |p| format!("python module via {p}")
+            |(p, v)| { format!("{v} (Python module via {p})") }
         )
     );
 
@@ -371,7 +383,7 @@ fn main() {
                 ..Stat::default()
             }
         };
-        let gm = if let Some(py) = &python {
+        let gm = if let Some((py, _)) = &python {
             let script = work.join("gmsh_hxt_p2.py");
             std::fs::write(&script, GMSH_SCRIPT).unwrap();
             measure(args.runs, || {
@@ -455,6 +467,7 @@ fn main() {
     }
     let doc = serde_json::json!({
         "runs": args.runs, "curvetet_threads": args.threads,
+        "gmsh_version": python.as_ref().map(|p| p.1.clone()),
         "commands": {
             "curvetet": "curvetet mesh IN_p2.msh -q --threads T -o OUT.msh --report R.json",
             "tetgen": "tetgen -pYqQ twin.off",
