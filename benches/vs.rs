@@ -9,6 +9,9 @@
 //! - curvetet: `curvetet mesh IN_p2.msh -o OUT.msh --threads T` — end to end: read, mesh,
 //!   optimize, certify, write (T = `--threads`, default 1: the targets are per core);
 //! - TetGen:   `tetgen -pYqQ IN_lin.off` (quality mesh, boundary kept), the linear twin;
+//!   and again with `-a` (a volume bound of 1.9 × the volume per curvetet tet) so that it
+//!   makes about as many tets as curvetet (plain -pYqQ has no size field and makes far
+//!   fewer on big surfaces) — column "tg=";
 //! - Gmsh:     when a Python with the `gmsh` module is found ($CURVETET_BENCH_PYTHON, the
 //!   PyPI gmsh 4.15 venv of scripts/install-deps, python3, /usr/bin/python3): merge the linear twin (STL), HXT 3D (Mesh.Algorithm3D = 10,
 //!   one thread), setOrder(2), write .msh; its time is measured inside the script (merge to
@@ -226,7 +229,7 @@ fn have(tool: &str) -> bool {
 
 /// Writes the linear twin of a P2 surface (its corners) as OFF and ASCII STL, with
 /// round-trip (17 significant digit) coordinates.
-fn write_linear(s: &curvetet::Surface, off: &Path, stl: &Path) {
+fn write_linear(s: &curvetet::Surface, off: &Path, stl: &Path) -> f64 {
     let nodes = s.nodes();
     let tris = s.triangles();
     let mut used = vec![u32::MAX; nodes.len()];
@@ -244,7 +247,13 @@ fn write_linear(s: &curvetet::Surface, off: &Path, stl: &Path) {
         let _ = writeln!(o, "{:e} {:e} {:e}", p[0], p[1], p[2]);
     }
     let mut st = String::from("solid twin\n");
+    let mut vol = 0.0;
     for t in tris {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|v| nodes[v as usize]);
+        vol += (a[0] * (b[1] * c[2] - b[2] * c[1])
+            + a[1] * (b[2] * c[0] - b[0] * c[2])
+            + a[2] * (b[0] * c[1] - b[1] * c[0]))
+            / 6.0;
         let _ = writeln!(
             o,
             "3 {} {} {}",
@@ -260,6 +269,7 @@ fn write_linear(s: &curvetet::Surface, off: &Path, stl: &Path) {
     st += "endsolid twin\n";
     std::fs::write(off, o).unwrap();
     std::fs::write(stl, st).unwrap();
+    vol
 }
 
 fn main() {
@@ -320,12 +330,13 @@ fn main() {
     let mut table = String::new();
     let mut json = Vec::new();
     let header = format!(
-        "{:<11} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>6} {:>6} {:>7} {:>7}",
+        "{:<11} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>8} {:>8} {:>8} {:>6} | {:>6} {:>6} {:>6} {:>7} {:>7}",
         "input", "tris",
         "ct tets", "ct s", "ct t/s", "ct B/t",
         "tg tets", "tg s", "tg t/s", "tg B/t",
+        "tg= tets", "tg= s", "tg= t/s", "B/t",
         "gm tets", "gm s", "gm t/s", "gm B/t",
-        "ct/tg", "ct/gm", "ct/tg/t", "ct/gm/t"
+        "ct/tg", "ct/tg=", "ct/gm", "ct/tg/t", "ct/gm/t"
     );
     eprintln!("{header}");
     table += &header;
@@ -342,7 +353,7 @@ fn main() {
         };
         let off = dir.join("twin.off");
         let stl = dir.join("twin.stl");
-        write_linear(&surface, &off, &stl);
+        let volume = write_linear(&surface, &off, &stl);
         let tris = surface.triangles().len();
 
         let report = dir.join("report.json");
@@ -365,9 +376,15 @@ fn main() {
                 .ok_or("no num_tets in report")? as usize;
             Ok((r.secs, r.rss, n))
         });
-        let tg = if tetgen {
+        let tetgen_run = |flags: &str| {
+            if !tetgen {
+                return Stat {
+                    err: Some("tetgen not found".into()),
+                    ..Stat::default()
+                };
+            }
             measure(args.runs, || {
-                let r = run(Command::new("tetgen").arg("-pYqQ").arg(&off), &dir)?;
+                let r = run(Command::new("tetgen").arg(flags).arg(&off), &dir)?;
                 let ele =
                     std::fs::read_to_string(dir.join("twin.1.ele")).map_err(|e| e.to_string())?;
                 let n = ele
@@ -377,9 +394,20 @@ fn main() {
                     .ok_or("bad .ele")?;
                 Ok((r.secs, r.rss, n))
             })
+        };
+        let tg = tetgen_run("-pYqQ");
+        // TetGen with a volume bound that gives about as many tets as curvetet made
+        // (-a at 1.9 × volume per curvetet tet: measured on the torus, ±20 %).
+        let tg_flags = if ct.ok() {
+            format!("-pYqQa{:e}", 1.9 * volume / ct.tets as f64)
+        } else {
+            String::new()
+        };
+        let tgm = if ct.ok() {
+            tetgen_run(&tg_flags)
         } else {
             Stat {
-                err: Some("tetgen not found".into()),
+                err: Some("no curvetet tet count to match".into()),
                 ..Stat::default()
             }
         };
@@ -432,19 +460,26 @@ fn main() {
             }
         };
         let line = format!(
-            "{:<11} {:>6} | {} | {} | {} | {:>6} {:>6} {:>7} {:>7}",
+            "{:<11} {:>6} | {} | {} | {} | {} | {:>6} {:>6} {:>6} {:>7} {:>7}",
             label,
             tris,
             cell(&ct),
             cell(&tg),
+            cell(&tgm),
             cell(&gm),
             ratio(&ct, &tg, false),
+            ratio(&ct, &tgm, false),
             ratio(&ct, &gm, false),
             ratio(&ct, &tg, true),
             ratio(&ct, &gm, true)
         );
         eprintln!("{line}");
-        for (tool, s) in [("curvetet", &ct), ("tetgen", &tg), ("gmsh", &gm)] {
+        for (tool, s) in [
+            ("curvetet", &ct),
+            ("tetgen", &tg),
+            ("tetgen -a", &tgm),
+            ("gmsh", &gm),
+        ] {
             if let Some(e) = &s.err {
                 eprintln!("    {tool} on {label}: {e}");
             }
@@ -463,6 +498,7 @@ fn main() {
         json.push(serde_json::json!({
             "input": label, "triangles": tris,
             "curvetet": js(&ct), "tetgen": js(&tg), "gmsh_hxt_p2": js(&gm),
+            "tetgen_matched": js(&tgm), "tetgen_matched_flags": tg_flags,
         }));
     }
     let doc = serde_json::json!({
@@ -471,6 +507,7 @@ fn main() {
         "commands": {
             "curvetet": "curvetet mesh IN_p2.msh -q --threads T -o OUT.msh --report R.json",
             "tetgen": "tetgen -pYqQ twin.off",
+            "tetgen_matched": "tetgen -pYqQa<1.9 V / curvetet tets> twin.off",
             "gmsh": "merge twin.stl; Mesh.Algorithm3D=10 (HXT), 1 thread; generate(3); setOrder(2); write",
         },
         "results": json,
@@ -478,7 +515,8 @@ fn main() {
     std::fs::write(&args.json, serde_json::to_string_pretty(&doc).unwrap()).unwrap();
     eprintln!(
         "columns: tets, median seconds, tets/s, peak RSS bytes per tet; ct/tg and ct/gm = time ratios, \
-         /t = per-tet time ratios (< 1: curvetet faster)\nJSON: {}",
+         /t = per-tet time ratios (< 1: curvetet faster); tg= = tetgen -pYqQa with a volume bound \
+         matched to curvetet's tet count\nJSON: {}",
         args.json.display()
     );
 }
