@@ -131,9 +131,20 @@ fn cgal_program() -> Result<PathBuf, String> {
             "-DNDEBUG",
         ];
         let libs = ["-lgmp", "-lmpfr"];
-        // FNV-1a of source and flags: the cache key.
+        // FNV-1a of source, flags, compiler version and CGAL version: the cache key.
+        let gxx = Command::new("g++")
+            .arg("-dumpfullversion")
+            .output()
+            .map(|o| o.stdout)
+            .unwrap_or_default();
+        let cgal = std::fs::read("/usr/include/CGAL/version.h").unwrap_or_default();
         let mut h: u64 = 0xcbf29ce484222325;
-        for b in text.iter().chain(args.concat().as_bytes()) {
+        for b in text
+            .iter()
+            .chain(args.concat().as_bytes())
+            .chain(&gxx)
+            .chain(&cgal)
+        {
             h = (h ^ u64::from(*b)).wrapping_mul(0x100000001b3);
         }
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("reference-bin");
