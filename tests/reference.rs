@@ -9,7 +9,8 @@
 //! - conformity: no flat, inverted or duplicate tet; every interior face in exactly two
 //!   tets with opposite orientations; curvetet's boundary == the P2 input triangles (corners
 //!   and mid nodes, by exact coordinates and orientation) and TetGen's boundary == the
-//!   linear input triangles (exact coordinates, -Y keeps them) == the P2 input's corners;
+//!   linear input triangles (exact coordinates, -Y keeps them); the linear twin's corners
+//!   == the P2 input's to 1e-15 relative (the .msh files carry 16 digits, the .off 17);
 //! - volume: curvetet's straight-sided volume == TetGen's == the volume enclosed by the
 //!   linear surface, to 1e-12 relative; curvetet's curved volume == the volume enclosed by
 //!   the P2 surface (computed here exactly) to 1e-9 relative and within 1e-4 of the
@@ -74,7 +75,8 @@ fn work_dir(name: &str) -> PathBuf {
     d
 }
 
-/// Runs `cmd` with a time limit; Ok(stderr) on success, Err(description) otherwise.
+/// Runs `cmd` with a time limit: Ok((stderr, wall seconds)) on success, else Err(what
+/// failed, with the tail of its output).
 fn run(mut cmd: Command, what: &str) -> Result<(String, f64), String> {
     let t0 = Instant::now();
     let mut child = cmd
