@@ -1,6 +1,7 @@
 """Checks what the MeshLab filter wrote.
 
 check_output.py INPUT_LIN.OFF CUT.PLY VOLUME.msh|.vtu...
+check_output.py --layer-off INPUT_LIN.OFF LAYER.OFF   (writes MeshLab's copy of the surface)
 
 - every volume mesh has been judged by `curvetet check --json` (VOLUME.check.json beside it):
   a certified-valid quadratic tet mesh;
@@ -64,7 +65,7 @@ def read_vtu(path):
     r.Update()
     g = r.GetOutput()
     pts = vtk_to_numpy(g.GetPoints().GetData()).astype(np.float64)
-    types = vtk_to_numpy(g.GetCellTypesArray())
+    types = [g.GetCellType(k) for k in range(g.GetNumberOfCells())]
     conn = vtk_to_numpy(g.GetCells().GetConnectivityArray())
     offs = vtk_to_numpy(g.GetCells().GetOffsetsArray())
     cells = {}
@@ -87,7 +88,28 @@ def ply_counts(path):
     return counts
 
 
+def write_layer_off(src, dst):
+    """The OFF surface as MeshLab holds it: vertices rounded to float, written exactly."""
+    xyz, _ = read_off(src)
+    toks = []
+    for line in open(src):
+        toks += line.split("#")[0].split()
+    nv, nf = int(toks[1]), int(toks[2])
+    rest = toks[4 + 3 * nv:]
+    out = ["OFF", f"{nv} {nf} 0"]
+    out += [" ".join(repr(float(x)) for x in p) for p in xyz.astype(np.float32).astype(np.float64)]
+    k = 0
+    for _ in range(nf):
+        n = int(rest[k])
+        out.append(" ".join(rest[k:k + 1 + n]))
+        k += 1 + n
+    open(dst, "w").write("\n".join(out) + "\n")
+
+
 def main():
+    if sys.argv[1] == "--layer-off":
+        write_layer_off(sys.argv[2], sys.argv[3])
+        return
     off, ply, volumes = sys.argv[1], sys.argv[2], sys.argv[3:]
     xyz, nf = read_off(off)
     layer = xyz.astype(np.float32).astype(np.float64)  # MeshLab's copy of the vertices
