@@ -6,6 +6,7 @@
 #   run_meshlabserver.sh dump WORK            meshlabserver -d lists the filter
 #   run_meshlabserver.sh mesh WORK IN_LIN.OFF an .mlx script meshes the surface
 #   run_meshlabserver.sh open WORK CLOSED.OFF an open surface (one facet dropped) fails cleanly
+#   run_meshlabserver.sh readme WORK IN.OFF   the README's .mlx example ($README) runs
 #
 # Environment (set by CMakeLists.txt): MESHLABSERVER, XVFB_RUN, PLUGIN, CURVETET_CLI, PYTHON,
 # TESTS_DIR, LIBCURVETET (the shared library), REQUIRE_SUCCESS (mesh: 1 = the surface must mesh);
@@ -135,6 +136,23 @@ PY
   [ ! -e "$work/out.msh" ] || fail "an output file was written for a failed run"
   [ ! -e "$work/cut.ply" ] || fail "a layer was saved after a failed run"
   echo "open surface: the filter failed cleanly (meshlabserver exit code $rc)"
+  ;;
+readme)
+  # The README's filter script, as printed there, on a surface: runs, and its volume mesh
+  # passes curvetet check.
+  "$PYTHON" - "$README" "$work/curvetet.mlx" <<'PY'
+import sys
+section = open(sys.argv[1]).read().split("\n## MeshLab\n", 1)[1].split("\n## ", 1)[0]
+open(sys.argv[2], "w").write(section.split("```xml\n", 1)[1].split("```", 1)[0])
+PY
+  rc=0
+  (cd "$work" && server -i "$input" -o cut.ply -l x -s curvetet.mlx >log.txt 2>&1) || rc=$?
+  cat "$work/log.txt"
+  [ "$rc" = 0 ] || fail "meshlabserver with the README's script: exit code $rc"
+  [ -s "$work/volume.msh" ] || fail "the README's script wrote no volume.msh"
+  "$CURVETET_CLI" check "$work/volume.msh" || fail "curvetet check volume.msh"
+  [ -s "$work/cut.ply" ] || fail "no cut layer saved"
+  echo "the README's filter script meshes $(basename "$input")"
   ;;
 *) fail "unknown mode $mode" ;;
 esac
