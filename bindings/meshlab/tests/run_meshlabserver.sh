@@ -23,6 +23,7 @@ work=$(cd "$work" && pwd)
 # and ours. meshlabserver's RUNPATH ($ORIGIN/../lib/<multiarch>/meshlab) finds the library.
 libdir=${MESHLAB_LIBDIR:-$(dirname "$(ldd "$MESHLABSERVER" | awk '/libmeshlab-common/ {print $3}')")}
 [ -f "$libdir/libmeshlab-common.so" ] || fail "no libmeshlab-common.so in '$libdir'"
+libdir=$(readlink -f "$libdir") # ldd says /usr/bin/../lib/...
 rel=${libdir#/usr/}
 root=$work/meshlab
 mkdir -p "$root/bin" "$root/$rel/plugins"
