@@ -14,14 +14,19 @@ use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::*;
 
 /// Largest cavity (front faces) the exact search takes on.
-pub(super) const MAX_CAVITY_FACES: usize = 40;
+pub(super) const MAX_CAVITY_FACES: usize = 100;
 /// Search nodes per cavity.
-const NODE_BUDGET: usize = 300;
-/// Id used for the Steiner point during the search.
-const STEINER: u32 = u32::MAX - 2;
+const NODE_BUDGET: usize = 2000;
+/// First id of the Steiner points added during the search (below the front's own
+/// special ids).
+const STEINER: u32 = u32::MAX - 64;
 
 struct Search<'s> {
-    pos: &'s dyn Fn(u32) -> P3,
+    base: &'s dyn Fn(u32) -> P3,
+    /// Steiner points added so far (ids `STEINER + k`).
+    steiner: Vec<P3>,
+    /// How many Steiner points the search may add where a face sees no vertex.
+    max_steiner: usize,
     /// Front faces around the cavity that are not part of it (never crossed).
     fixed: Vec<FaceRef>,
     verts: Vec<u32>,
@@ -32,10 +37,36 @@ struct Search<'s> {
 }
 
 impl Search<'_> {
-    fn valid_apexes(&self, fi: usize, buf: &mut Vec<(f64, u32)>) {
-        buf.clear();
+    fn pos(&self, i: u32) -> P3 {
+        if i >= STEINER && ((i - STEINER) as usize) < self.steiner.len() {
+            self.steiner[(i - STEINER) as usize]
+        } else {
+            (self.base)(i)
+        }
+    }
+
+    /// Is `v` a valid apex for open face `fi`, and its quality.
+    fn apex_quality(&self, fi: usize, v: u32, near: &[FaceRef]) -> Option<f64> {
         let f = self.open[fi].v;
-        let fp = f.map(|v| (self.pos)(v));
+        let fp = f.map(|v| self.pos(v));
+        let p = self.pos(v);
+        if orient3d(fp[0], fp[1], fp[2], p) <= 0 {
+            return None;
+        }
+        let t = [f[0], f[1], f[2], v];
+        let tp = [fp[0], fp[1], fp[2], p];
+        if validity::check(t, tp, near, |i| self.pos(i), 0.0).is_err() {
+            return None;
+        }
+        if !(self.curved_ok)(t, &tp) {
+            return None;
+        }
+        let (mn, mx) = dihedral_extremes(&tp);
+        let q = 1.0 - skewness_from_extremes(mn, mx);
+        Some(if q.is_nan() { -1.0 } else { q })
+    }
+
+    fn near_of(&self, fi: usize) -> Vec<FaceRef> {
         let mut near: Vec<FaceRef> = Vec::with_capacity(self.open.len() + self.fixed.len());
         for (k, g) in self.open.iter().enumerate() {
             if k != fi {
@@ -43,25 +74,53 @@ impl Search<'_> {
             }
         }
         near.extend_from_slice(&self.fixed);
+        near
+    }
+
+    /// Try Steiner points above open face `fi` (which sees no vertex): along its normal at
+    /// a few heights; recurse with each valid one.
+    fn dfs_with_steiner(&mut self, fi: usize) -> bool {
+        if self.steiner.len() >= self.max_steiner {
+            return false;
+        }
+        let f = self.open[fi].v;
+        let fp = f.map(|v| self.pos(v));
+        let c = centroid3(fp[0], fp[1], fp[2]);
+        let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
+        let l = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
+        let near = self.near_of(fi);
+        let id = STEINER + self.steiner.len() as u32;
+        for s in [0.8, 0.5, 0.3, 0.15] {
+            let p = axpy(c, s * (2.0f64 / 3.0).sqrt() * l, n);
+            self.steiner.push(p);
+            if self.apex_quality(fi, id, &near).is_some() {
+                self.verts.push(id);
+                let (b, r, a) = self.apply(fi, id);
+                if self.dfs() {
+                    return true;
+                }
+                self.undo(b, r, a);
+                self.verts.pop();
+            }
+            self.steiner.pop();
+            if self.nodes > NODE_BUDGET {
+                return false;
+            }
+        }
+        false
+    }
+
+    fn valid_apexes(&self, fi: usize, buf: &mut Vec<(f64, u32)>) {
+        buf.clear();
+        let f = self.open[fi].v;
+        let near = self.near_of(fi);
         for &v in &self.verts {
             if f.contains(&v) {
                 continue;
             }
-            let p = (self.pos)(v);
-            if orient3d(fp[0], fp[1], fp[2], p) <= 0 {
-                continue;
+            if let Some(q) = self.apex_quality(fi, v, &near) {
+                buf.push((q, v));
             }
-            let t = [f[0], f[1], f[2], v];
-            let tp = [fp[0], fp[1], fp[2], p];
-            if validity::check(t, tp, &near, |i| (self.pos)(i), 0.0).is_err() {
-                continue;
-            }
-            if !(self.curved_ok)(t, &tp) {
-                continue;
-            }
-            let (mn, mx) = dihedral_extremes(&tp);
-            let q = 1.0 - skewness_from_extremes(mn, mx);
-            buf.push((if q.is_nan() { -1.0 } else { q }, v));
         }
         buf.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     }
@@ -114,7 +173,7 @@ impl Search<'_> {
         for fi in 0..self.open.len() {
             self.valid_apexes(fi, &mut buf);
             if buf.is_empty() {
-                return false;
+                return self.dfs_with_steiner(fi);
             }
             if best.as_ref().map_or(true, |b| buf.len() < b.1.len()) {
                 best = Some((fi, buf.clone()));
@@ -219,34 +278,31 @@ impl Mesher<'_> {
                 boundary: self.faces[k as usize].btri != u32::MAX,
             })
             .collect();
-        // First without, then with one Steiner point.
-        for with_steiner in [false, true] {
-            let steiner = if with_steiner {
-                match self.kernel_point(&open) {
-                    Some(p) => Some(p),
-                    None => break,
-                }
-            } else {
-                None
-            };
+        // First on the cavity's own vertices, then with the kernel's centre as a Steiner
+        // point, then with up to three Steiner points placed where a face sees no vertex.
+        let kernel = self.kernel_point(&open);
+        let passes: [(Option<P3>, usize); 3] = [(None, 0), (kernel, 1), (None, 3)];
+        for (pre, max_steiner) in passes {
+            if max_steiner == 1 && pre.is_none() {
+                continue;
+            }
             let pts = &self.pts;
-            let pos = move |i: u32| -> P3 {
-                if i == STEINER {
-                    steiner.unwrap_or([f64::NAN; 3])
-                } else {
-                    pts[i as usize]
-                }
-            };
+            let base =
+                move |i: u32| -> P3 { pts.get(i as usize).copied().unwrap_or([f64::NAN; 3]) };
             let me = &*self;
             let curved_ok = |t: [u32; 4], tp: &[P3; 4]| {
                 me.p2_nodes(t, tp).map_or(true, |x| super::curved_valid(&x))
             };
             let mut vs = verts.clone();
-            if steiner.is_some() {
+            let mut steiner = Vec::new();
+            if let Some(p) = pre {
+                steiner.push(p);
                 vs.push(STEINER);
             }
             let mut s = Search {
-                pos: &pos,
+                base: &base,
+                steiner,
+                max_steiner,
                 fixed: fixed.clone(),
                 verts: vs,
                 open: open.clone(),
@@ -256,9 +312,15 @@ impl Mesher<'_> {
             };
             if s.dfs() {
                 let tets = s.out;
-                let sid = steiner.map(|p| self.new_point(p));
+                let ids: Vec<u32> = s.steiner.iter().map(|&p| self.new_point(p)).collect();
                 for t in tets {
-                    let t = t.map(|v| if v == STEINER { sid.unwrap_or(v) } else { v });
+                    let t = t.map(|v| {
+                        if v >= STEINER && ((v - STEINER) as usize) < ids.len() {
+                            ids[(v - STEINER) as usize]
+                        } else {
+                            v
+                        }
+                    });
                     let base = [t[0], t[1], t[2]];
                     let Some(&fid) = self.face_map.get(&super::key3(base)) else {
                         continue;

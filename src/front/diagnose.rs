@@ -77,12 +77,41 @@ impl Mesher<'_> {
                 "  apex {id}: dist {:.4}, min dihedral {mn:.2}, skew {:.3}, validity {:?}, P2 {}",
                 dist(p, a),
                 skewness_from_extremes(mn, mx),
-                v.map(|x| x.min_gap_deg),
+                v.as_ref()
+                    .map(|x| (x.min_gap_deg, x.min_gap_boundary_deg, x.num_closings)),
                 match curved {
                     None => "straight",
                     Some(true) => "valid",
                     Some(false) => "INVALID",
                 }
+            );
+        }
+        // New points along the inward normal, as the front would place them.
+        for s in [1.0, 0.7, 0.5, 0.3] {
+            let p = axpy(c, s * h, n);
+            let t = [f.v[0], f.v[1], f.v[2], validity::NEW_POINT];
+            let tp = [fp[0], fp[1], fp[2], p];
+            let mut bb = Aabb::of(&tp);
+            for d in 0..3 {
+                bb.lo[d] -= h;
+                bb.hi[d] += h;
+            }
+            self.gather_near(&bb, fid);
+            let pts = &self.pts;
+            let pos = |i: u32| {
+                if i == validity::NEW_POINT {
+                    p
+                } else {
+                    pts[i as usize]
+                }
+            };
+            let v = validity::check(t, tp, &self.near, pos, 0.0);
+            let (mn, mx) = dihedral_extremes(&tp);
+            let _ = writeln!(
+                out,
+                "  new point at {s} h: min dihedral {mn:.2}, skew {:.3}, validity {:?}",
+                skewness_from_extremes(mn, mx),
+                v.map(|x| (x.min_gap_deg, x.min_gap_boundary_deg))
             );
         }
         out

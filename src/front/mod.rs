@@ -255,7 +255,7 @@ impl<'a> Mesher<'a> {
             if let Some(&g) = self.edges.get(&(v[(k + 1) % 3], v[k])) {
                 let w = self.wedge_deg(g, id);
                 let gf = self.faces[g as usize];
-                if w < WEDGE_FIRST_DEG && (gf.qclass == 1 || w < gf.qkey) {
+                if w < WEDGE_FIRST_DEG && (gf.qclass != 0 || w < gf.qkey) {
                     self.faces[g as usize].ver += 1;
                     self.enqueue(g);
                 }
@@ -295,8 +295,10 @@ impl<'a> Mesher<'a> {
         let p = self.face_pts(id);
         let (class, key) = if wedge < WEDGE_FIRST_DEG {
             (0, wedge)
-        } else {
+        } else if f.btri != u32::MAX {
             (1, face_size(&p))
+        } else {
+            (2, face_size(&p))
         };
         self.heap
             .push(Reverse((f.tries, class, Key(key), id, f.ver)));
@@ -450,6 +452,8 @@ impl<'a> Mesher<'a> {
         };
         let open = self.faces.iter().filter(|f| f.alive).count();
         if std::env::var_os("CURVETET_DIAGNOSE").is_some() {
+            let comp = self.component(fid, 100_000).map_or(0, |c| c.len());
+            eprintln!("stuck front component: {comp} faces");
             eprintln!("{}", self.diagnose(fid));
         }
         Error::MeshingFailed {
@@ -579,7 +583,7 @@ impl<'a> Mesher<'a> {
                 0.97,
                 self.opts.min_edge_face_angle_deg / 2.5,
             ),
-            _ => (0.0, 1.0, 0.0),
+            _ => (0.0, 1.0, 1.0),
         };
         let mut cands = std::mem::take(&mut self.cands);
         cands.retain_mut(|cd| {
@@ -619,6 +623,7 @@ impl<'a> Mesher<'a> {
             _ => (0.12 * target, 0.0),
         };
         let mut chosen = None;
+        let mut fallback = None;
         for cd in &cands {
             let apex = if cd.id == NEW {
                 validity::NEW_POINT
@@ -639,10 +644,10 @@ impl<'a> Mesher<'a> {
             let Ok(verdict) = validity::check(t, tp, &self.near, pos, prox) else {
                 continue;
             };
-            if verdict.min_gap_deg < min_gap || verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG
-            {
+            if verdict.min_gap_deg < min_gap {
                 continue;
             }
+            let thin_boundary_gap = verdict.min_gap_boundary_deg < MIN_BOUNDARY_GAP_DEG;
             let mut p2_invalid = false;
             if let Some(x) = self.p2_nodes(t, &tp) {
                 if !curved_valid(&x) {
@@ -670,7 +675,13 @@ impl<'a> Mesher<'a> {
                     break;
                 }
             }
-            if !closable && level < 3 {
+            if (!closable || thin_boundary_gap) && level < 3 {
+                // At level 2 a candidate that fails only the look-ahead or the boundary gap
+                // floor is still taken when nothing else passes: the wedge it leaves may
+                // close another way, and a stuck face certainly does not.
+                if level == 2 && fallback.is_none() && !p2_invalid {
+                    fallback = Some(*cd);
+                }
                 continue;
             }
             if p2_invalid {
@@ -680,7 +691,7 @@ impl<'a> Mesher<'a> {
             break;
         }
         self.cands = cands;
-        let Some(cd) = chosen else {
+        let Some(cd) = chosen.or(fallback) else {
             return false;
         };
         let apex = if cd.id == NEW {
@@ -785,11 +796,18 @@ impl<'a> Mesher<'a> {
     }
 }
 
-/// Face size for the queue: longest edge (smallest faces first).
+/// Face size for the queue (smallest faces first): the smallest altitude, squared, so a
+/// skinny face (a thin boundary strip) is meshed while its surroundings are still open.
 fn face_size(p: &[P3; 3]) -> f64 {
-    dist2(p[0], p[1])
+    let l2 = dist2(p[0], p[1])
         .max(dist2(p[1], p[2]))
-        .max(dist2(p[2], p[0]))
+        .max(dist2(p[2], p[0]));
+    let a2 = norm2(tri_normal(p[0], p[1], p[2])); // (2 x area)²
+    if l2 > 0.0 {
+        a2 / l2
+    } else {
+        0.0
+    }
 }
 
 /// Certified positivity of a curved candidate's Jacobian (Bernstein bounds).
