@@ -52,11 +52,7 @@ const SURFACES: [(&str, f64, f64, f64, &str); 6] = [
 /// the meshing step itself is reported (with curvetet's message) instead of failing the
 /// test; TetGen and CGAL are still checked, and if curvetet does produce a mesh every check
 /// applies to it. Remove the entry when the surface meshes.
-const KNOWN_CURVETET_FAILURES: [(&str, &str); 1] = [(
-    "hinge",
-    "no valid mesh of the genus-5 hinge yet: the front did not close (before main 29e154d), \
-     now it closes but 41 tets fail certification; the lead is fixing the front",
-)];
+const KNOWN_CURVETET_FAILURES: [(&str, &str); 0] = [];
 
 /// Wall-clock limit per tool run, so a stuck front fails instead of hanging the suite.
 const TIME_LIMIT: Duration = Duration::from_secs(600);
