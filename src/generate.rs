@@ -4,6 +4,7 @@
 use crate::front::size::{regular_edge_from_area, SizeField};
 use crate::front::{run_front, FrontStats};
 use crate::geom::quadrature::tri6_area;
+use crate::geom::shape::TET10_EDGES;
 use crate::mesh::quality::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::options::{Options, SizeMode};
@@ -121,6 +122,7 @@ fn generate_inner(
         surface.tags(),
     );
     times.assemble = t.elapsed().as_secs_f64();
+    let mesh = inject_fault(mesh, surface.nodes().len());
 
     if progress(1.0, "certify") {
         return Err(Error::Cancelled);
@@ -171,4 +173,46 @@ fn generate_inner(
         times,
         size: size_value,
     })
+}
+
+/// The environment variable that makes [`generate`] corrupt its own mesh just before the
+/// final check, to prove the check catches it (`Error::InvalidMesh`, C status
+/// `CURVETET_ERR_INVALID_MESH`, CLI exit 6): `invert[:T]` swaps two corners of tet `T`
+/// (default 0; conformity fails), `jacobian[:T]` moves an interior mid node of tet `T` next
+/// to a corner (the mesh stays conforming but tet `T` is not certified valid). Tests only.
+pub const INJECT_FAULT_ENV: &str = "CURVETET_INJECT_INVALID_MESH";
+
+fn inject_fault(mut mesh: TetMesh, surface_nodes: usize) -> TetMesh {
+    let Ok(spec) = std::env::var(INJECT_FAULT_ENV) else {
+        return mesh;
+    };
+    let (kind, tet) = spec.split_once(':').unwrap_or((spec.as_str(), "0"));
+    let Some(t) = tet.parse::<usize>().ok().filter(|&t| t < mesh.tets.len()) else {
+        return mesh;
+    };
+    match kind {
+        "invert" => {
+            let e = &mut mesh.tets[t];
+            // Swap corners 0 and 1 and the mid nodes that follow them: (1,2)<->(2,0) and
+            // (3,0)<->(3,1); the tet is then inverted, its faces mismatched.
+            e.swap(0, 1);
+            e.swap(5, 6);
+            e.swap(7, 9);
+        }
+        "jacobian" => {
+            let e = mesh.tets[t];
+            if let Some(k) = (0..6).find(|&k| e[4 + k] as usize >= surface_nodes) {
+                let (a, b) = (
+                    mesh.nodes[e[TET10_EDGES[k][0]] as usize],
+                    mesh.nodes[e[TET10_EDGES[k][1]] as usize],
+                );
+                // A mid node closer than a quarter of the edge to a corner: the Jacobian
+                // is negative at that corner.
+                mesh.nodes[e[4 + k] as usize] =
+                    std::array::from_fn(|i| a[i] + 0.05 * (b[i] - a[i]));
+            }
+        }
+        _ => {}
+    }
+    mesh
 }
