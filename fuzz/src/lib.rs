@@ -141,7 +141,9 @@ fn damaged_icosphere(mode: u8, d: &[u8]) -> Arrays {
             5 => {
                 if !tris.is_empty() {
                     tris.remove(a % nt);
-                    tags.remove(a % nt);
+                    if a % nt < tags.len() {
+                        tags.remove(a % nt);
+                    }
                 }
             }
             6 => {
