@@ -59,6 +59,12 @@ pub struct FrontStats {
     /// Tets accepted as a last resort with a non-positive P2 Jacobian (linear-valid, with
     /// a free mid node), left for the high-order optimizer to untangle.
     pub p2_invalid: u64,
+    /// Whole-front restarts after the front could not be closed (see [`RESTARTS`]).
+    pub restarts: u32,
+    /// Search radius factor of the run that succeeded.
+    pub alpha: f64,
+    /// Size field factor of the run that succeeded.
+    pub size_scale: f64,
 }
 
 #[derive(Clone, Copy)]
@@ -139,7 +145,11 @@ pub(crate) struct Mesher<'a> {
     vtree: MutableKdTree<f64, 3>,
     tets: Vec<[u32; 4]>,
     tet_alive: Vec<bool>,
-    size: SizeField,
+    size: &'a SizeField,
+    /// Multiplies the size field (restarts refine).
+    size_scale: f64,
+    /// Candidate search radius factor (the user's alpha, changed on restarts).
+    alpha: f64,
     stats: FrontStats,
     repairs_at: HashMap<(i32, i32, i32), u32>,
     repair_cell: f64,
@@ -155,7 +165,7 @@ impl<'a> Mesher<'a> {
         surf_nodes: &'a [P3],
         surf_tris: &'a [[u32; 6]],
         opts: &'a Options,
-        size: SizeField,
+        size: &'a SizeField,
     ) -> Mesher<'a> {
         let n_surf = surf_nodes.len();
         let mut edge_len_sum = 0.0;
@@ -197,6 +207,8 @@ impl<'a> Mesher<'a> {
             tets: Vec::new(),
             tet_alive: Vec::new(),
             size,
+            size_scale: 1.0,
+            alpha: opts.alpha,
             stats: FrontStats::default(),
             repairs_at: HashMap::default(),
             repair_cell: 2.0 * mean_edge,
@@ -423,7 +435,10 @@ impl<'a> Mesher<'a> {
             }
             // ...else, where remeshing has not helped, accept a tet the optimizer must
             // untangle...
-            if self.repair_count(fid) >= 4 && self.advance(fid, 3) {
+            // (Right after the first failed repair when the optimizer will run; without
+            // it such a tet would fail certification, so only as a late resort.)
+            let late = if self.opts.optimize { 1 } else { 4 };
+            if self.repair_count(fid) >= late && self.advance(fid, 3) {
                 continue;
             }
             // ...else remesh around it.
@@ -484,16 +499,16 @@ impl<'a> Mesher<'a> {
             normalize(flat_n)
         };
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let l_field = self.size.at(c);
+        let l_field = self.size_scale * self.size.at(c);
         let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);
         let a = axpy(c, h, n);
         let (radius, min_new_dist) = match level {
             // New points keep away from existing ones by a fraction of the *field* size,
             // so a pocket of small faces cannot breed ever smaller elements.
-            0 => (self.opts.alpha * h, 0.45 * l_field),
-            1 => (2.0 * self.opts.alpha * h, 0.35 * l_field),
-            _ => (3.0 * self.opts.alpha * h, 0.25 * l_field),
+            0 => (self.alpha * h, 0.45 * l_field),
+            1 => (2.0 * self.alpha * h, 0.35 * l_field),
+            _ => (3.0 * self.alpha * h, 0.25 * l_field),
         };
         // Candidate existing vertices.
         let found = self
@@ -583,7 +598,7 @@ impl<'a> Mesher<'a> {
                 0.97,
                 self.opts.min_edge_face_angle_deg / 2.5,
             ),
-            _ => (0.0, 1.0, 0.0),
+            _ => (0.0, 1.0, 1.0),
         };
         let mut cands = std::mem::take(&mut self.cands);
         cands.retain_mut(|cd| {
@@ -815,7 +830,16 @@ fn curved_valid(x: &[P3; 10]) -> bool {
     certify(x).is_valid()
 }
 
-/// Run the front on a checked surface's arrays.
+/// Restart schedule, as (alpha factor, size factor): when local remeshing cannot close the
+/// front, the whole front runs again with a narrower, then a wider candidate search, then a
+/// finer size. The front is greedy; another radius changes every choice it makes, so a
+/// configuration that traps one run rarely traps the next (the hinge at alpha 2.5 closes
+/// at 2.0). Deterministic: the same input always takes the same attempts; the report gives
+/// the attempt that succeeded.
+pub const RESTARTS: [(f64, f64); 4] = [(1.0, 1.0), (0.8, 1.0), (1.3, 1.0), (1.0, 0.85)];
+
+/// Run the front on a checked surface's arrays, restarting per [`RESTARTS`] when it
+/// cannot close.
 pub fn run_front(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
@@ -823,18 +847,46 @@ pub fn run_front(
     size: SizeField,
     progress: Progress,
 ) -> Result<FrontOutput> {
-    let mut m = Mesher::new(surf_nodes, surf_tris, opts, size);
-    m.run(progress)?;
-    let tets: Vec<[u32; 4]> = m
-        .tets
-        .iter()
-        .zip(&m.tet_alive)
-        .filter(|(_, a)| **a)
-        .map(|(t, _)| *t)
-        .collect();
-    Ok(FrontOutput {
-        pts: m.pts,
-        tets,
-        stats: m.stats,
+    let mut failures = Vec::new();
+    let mut last_partial = None;
+    for (attempt, &(fa, fs)) in RESTARTS.iter().enumerate() {
+        let mut m = Mesher::new(surf_nodes, surf_tris, opts, &size);
+        m.alpha = opts.alpha * fa;
+        m.size_scale = fs;
+        m.stats.restarts = attempt as u32;
+        m.stats.alpha = m.alpha;
+        m.stats.size_scale = fs;
+        match m.run(progress) {
+            Ok(()) => {
+                let tets: Vec<[u32; 4]> = m
+                    .tets
+                    .iter()
+                    .zip(&m.tet_alive)
+                    .filter(|(_, a)| **a)
+                    .map(|(t, _)| *t)
+                    .collect();
+                return Ok(FrontOutput {
+                    pts: m.pts,
+                    tets,
+                    stats: m.stats,
+                });
+            }
+            Err(Error::MeshingFailed { msg, partial }) => {
+                failures.push(format!("alpha {:.3}, size x{fs}: {msg}", m.alpha));
+                last_partial = partial;
+                if attempt + 1 < RESTARTS.len() && progress(0.0, "front (restart)") {
+                    return Err(Error::Cancelled);
+                }
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Err(Error::MeshingFailed {
+        msg: format!(
+            "{} attempts failed: {}",
+            RESTARTS.len(),
+            failures.join("; ")
+        ),
+        partial: last_partial,
     })
 }

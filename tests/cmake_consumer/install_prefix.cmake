@@ -1,5 +1,6 @@
 # ctest fixture: install the build tree into a fresh PREFIX and check the layout.
 #   cmake -DBUILD_DIR=... -DPREFIX=... -DLIBDIR=lib -DSONAME=libcurvetet.so.X [-DVTK=ON]
+#         [-DMESHLAB=ON]
 #         -P install_prefix.cmake
 file(REMOVE_RECURSE "${PREFIX}")
 execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${PREFIX}"
@@ -8,6 +9,13 @@ set(_vtk_files "")
 if(VTK)
   set(_vtk_files "${LIBDIR}/libcurvetet_vtk.so" "include/vtkCurveTetFilter.h"
                  "${LIBDIR}/cmake/CurveTet/CurveTetVTKTargets.cmake")
+endif()
+if(MESHLAB)
+  # MeshLab's plugin folder under the prefix (/usr: where Debian's MeshLab looks).
+  file(GLOB_RECURSE _plugin RELATIVE "${PREFIX}" "${PREFIX}/*/libfilter_curvetet.so")
+  if(NOT _plugin MATCHES "^lib/([a-z0-9_]+-linux-gnu/)?meshlab/plugins/libfilter_curvetet.so$")
+    message(FATAL_ERROR "the MeshLab plugin is not in <prefix>/lib/<multiarch>/meshlab/plugins: '${_plugin}'")
+  endif()
 endif()
 foreach(f ${_vtk_files}
     "${LIBDIR}/libcurvetet.a"
