@@ -34,7 +34,7 @@ fn surfaces() -> Vec<PathBuf> {
     out
 }
 
-fn write_all(mesh: &curvetet::TetMesh) -> Vec<Vec<u8>> {
+fn write_all(mesh: &curvetet::TetMesh) -> Files {
     // Every writer, so nothing format-specific hides a difference.
     let mut out = Vec::new();
     for (format, binary, version) in [
@@ -53,8 +53,11 @@ fn write_all(mesh: &curvetet::TetMesh) -> Vec<Vec<u8>> {
     out
 }
 
+/// The bytes of each output file.
+type Files = Vec<Vec<u8>>;
+
 /// The output files, or the error message and the files of the mesh it keeps.
-fn mesh_bytes(path: &Path, threads: usize) -> Result<Vec<Vec<u8>>, (String, Vec<Vec<u8>>)> {
+fn mesh_bytes(path: &Path, threads: usize) -> Result<Files, (String, Files)> {
     let s = io::read_surface(path).unwrap();
     let opts = Options {
         threads,
