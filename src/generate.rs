@@ -4,6 +4,7 @@
 use crate::front::size::{regular_edge_from_area, SizeField};
 use crate::front::{run_front, FrontStats};
 use crate::geom::quadrature::tri6_area;
+use crate::geom::shape::TET10_EDGES;
 use crate::mesh::quality::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::optimize::{
@@ -138,6 +139,7 @@ fn generate_inner(
         surface.tags(),
     );
     times.assemble = t.elapsed().as_secs_f64();
+    let mesh = inject_fault(mesh, surface.nodes().len());
 
     if opts.optimize {
         let t = Instant::now();
@@ -197,4 +199,80 @@ fn generate_inner(
         optimize: ostats,
         size: size_value,
     })
+}
+
+/// The environment variable that makes [`generate`] corrupt its own mesh just before the
+/// final check, to prove the check catches it (`Error::InvalidMesh`, C status
+/// `CURVETET_ERR_INVALID_MESH`, CLI exit 6): `invert[:T]` swaps two corners of tet `T`
+/// (default 0; conformity fails), `jacobian[:T]` moves an interior mid node of tet `T` next
+/// to a corner (the mesh stays conforming but tet `T` is not certified valid). Tests only.
+pub const INJECT_FAULT_ENV: &str = "CURVETET_INJECT_INVALID_MESH";
+
+fn inject_fault(mut mesh: TetMesh, surface_nodes: usize) -> TetMesh {
+    let Ok(spec) = std::env::var(INJECT_FAULT_ENV) else {
+        return mesh;
+    };
+    let (kind, tet) = spec.split_once(':').unwrap_or((spec.as_str(), "0"));
+    let Some(t) = tet.parse::<usize>().ok().filter(|&t| t < mesh.tets.len()) else {
+        return mesh;
+    };
+    match kind {
+        "invert" => {
+            let e = &mut mesh.tets[t];
+            // Swap corners 0 and 1 and the mid nodes that follow them: (1,2)<->(2,0) and
+            // (3,0)<->(3,1); the tet is then inverted, its faces mismatched.
+            e.swap(0, 1);
+            e.swap(5, 6);
+            e.swap(7, 9);
+        }
+        "jacobian" => {
+            let e = mesh.tets[t];
+            if let Some(k) = (0..6).find(|&k| e[4 + k] as usize >= surface_nodes) {
+                let (a, b) = (
+                    mesh.nodes[e[TET10_EDGES[k][0]] as usize],
+                    mesh.nodes[e[TET10_EDGES[k][1]] as usize],
+                );
+                // A mid node closer than a quarter of the edge to a corner: the Jacobian
+                // is negative at that corner.
+                mesh.nodes[e[4 + k] as usize] =
+                    std::array::from_fn(|i| a[i] + 0.05 * (b[i] - a[i]));
+            }
+        }
+        _ => {}
+    }
+    mesh
+}
+
+/// Bytes per tetrahedron at the peak of [`generate`] (front, P2 assembly, certification),
+/// measured on graded torus meshes of 6 k to 330 k tets (about 500 bytes per tet there;
+/// the estimate uses less so that it stays a lower bound).
+pub const BYTES_PER_TET: u64 = 400;
+/// Bytes per input triangle held by the surface and its topology.
+pub const BYTES_PER_TRIANGLE: u64 = 300;
+
+/// A lower-bound estimate of the peak memory [`generate`] needs for `surface` under
+/// `opts`, in bytes: enough to refuse early an input that certainly does not fit a budget
+/// (the CLI's `--max-memory`); an estimate under the budget does not promise the run fits.
+///
+/// Tets are estimated as the enclosed volume over the regular tet volume of the target
+/// size for a uniform size, and as twice the boundary triangles for a graded size (the
+/// graded meshes measured have 3 to 11 tets per boundary triangle).
+pub fn estimated_peak_memory(surface: &Surface, opts: &Options) -> u64 {
+    let tris = surface.triangles().len() as f64;
+    let by_size = match opts.size {
+        SizeMode::Graded => 0.0,
+        SizeMode::Fixed(_) | SizeMode::Uniform => {
+            let h = size_field(surface, opts).min_size();
+            let regular = h * h * h / (6.0 * std::f64::consts::SQRT_2);
+            if regular > 0.0 {
+                surface.chord_volume().abs() / regular
+            } else {
+                f64::INFINITY
+            }
+        }
+    };
+    let tets = by_size.max(2.0 * tris).min(1e18);
+    (tets as u64)
+        .saturating_mul(BYTES_PER_TET)
+        .saturating_add((tris as u64).saturating_mul(BYTES_PER_TRIANGLE))
 }

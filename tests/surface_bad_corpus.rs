@@ -2,7 +2,8 @@
 //! every file is rejected with the defect kind EXPECTED.txt names, and the message names
 //! an element (triangle, edge or node) or says why the whole model is rejected. P2 files
 //! (.msh) go to `Surface::new`; linear files (.off, .stl) go through the real readers to
-//! `Surface::from_linear`, and must give the same kinds as their P2 counterparts.
+//! `Surface::from_linear`, and must give the same kinds as their P2 counterparts. Each case
+//! must finish within 10 s (a hang guard).
 
 mod common;
 
@@ -31,7 +32,14 @@ fn every_bad_file_gives_its_expected_kind() {
     let mut kinds = std::collections::BTreeSet::new();
     for line in expected.lines().filter(|l| !l.trim().is_empty()) {
         let (file, kind) = line.split_once(' ').expect("`filename kind-name`");
-        match corpus_surface(&dir.join(file)) {
+        let t = std::time::Instant::now();
+        let result = corpus_surface(&dir.join(file));
+        assert!(
+            t.elapsed() < std::time::Duration::from_secs(10),
+            "{file}: took {:?} (hang guard: 10 s per case)",
+            t.elapsed()
+        );
+        match result {
             Err(Error::InvalidSurface { kind: k, msg }) => {
                 assert_eq!(k.name(), kind, "{file}: {msg}");
                 let names_something = [

@@ -94,6 +94,45 @@ struct MeshArgs {
     curve: CurveArgs,
     #[command(flatten)]
     mesh: MeshOptions,
+    /// Refuse early, with a clear error, an input that would need more memory than this
+    /// (bytes, or with a K, M, G or T suffix, powers of 1024): checked on the file size
+    /// before reading and on an estimate of the meshing peak before meshing.
+    #[arg(long, value_parser = parse_bytes)]
+    max_memory: Option<u64>,
+}
+
+/// `123`, `64K`, `500M`, `4G`, `1T` (powers of 1024; a trailing `B`/`iB` is allowed).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let t = t
+        .strip_suffix("iB")
+        .or_else(|| t.strip_suffix('B'))
+        .unwrap_or(t);
+    let (num, mult) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => {
+            let m: u64 = match c.to_ascii_uppercase() {
+                'K' => 1 << 10,
+                'M' => 1 << 20,
+                'G' => 1 << 30,
+                'T' => 1 << 40,
+                _ => return Err(format!("unknown size suffix in {s:?} (use K, M, G or T)")),
+            };
+            (&t[..i], m)
+        }
+        _ => (t, 1),
+    };
+    let v: f64 = num
+        .trim()
+        .parse()
+        .map_err(|_| format!("not a memory size: {s:?} (e.g. 4G, 500M)"))?;
+    if !(v.is_finite() && v > 0.0) {
+        return Err(format!("the memory size must be > 0 (got {s:?})"));
+    }
+    Ok((v * mult as f64).min(u64::MAX as f64) as u64)
+}
+
+fn mib(b: u64) -> String {
+    format!("{:.1} MiB", b as f64 / (1u64 << 20) as f64)
 }
 
 #[derive(Args)]
@@ -372,7 +411,34 @@ fn check_output(output: &Path) -> Result<(), Error> {
 
 fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     check_output(&a.output)?;
+    if let Some(budget) = a.max_memory {
+        // Reading holds at least the file's bytes' worth of nodes and triangles.
+        let len = std::fs::metadata(&a.input)
+            .map_err(|e| Error::io(&a.input, e))?
+            .len();
+        if len > budget {
+            return Err(Error::InvalidArgument(format!(
+                "{}: reading this {} file needs more than --max-memory {}",
+                a.input.display(),
+                mib(len),
+                mib(budget)
+            )));
+        }
+    }
     let surface = read_surface_any(&a.input, &a.curve)?;
+    if let Some(budget) = a.max_memory {
+        let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
+        if need > budget {
+            return Err(Error::InvalidArgument(format!(
+                "{}: meshing {} triangles needs at least about {} (estimate), more than \
+                 --max-memory {}",
+                a.input.display(),
+                surface.triangles().len(),
+                mib(need),
+                mib(budget)
+            )));
+        }
+    }
     run_mesh(&surface, &a.mesh, &a.output)
 }
 

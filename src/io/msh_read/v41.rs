@@ -146,7 +146,8 @@ impl Reader<'_> {
             c.bin_i32("entity tag")?;
             let param = c.bin_i32("parametric flag")?;
             let n = c.bin_usize(ds, "number of nodes in block")?;
-            if tags.len() as u64 + n > nnodes {
+            // (tags.len() <= nnodes here; `tags.len() + n` could overflow.)
+            if n > nnodes - tags.len() as u64 {
                 return Err(c.err("node blocks hold more nodes than the header says"));
             }
             let extra = if param != 0 {

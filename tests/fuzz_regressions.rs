@@ -1,0 +1,73 @@
+//! Replays inputs the fuzzers found (tests/data/fuzz/<target>/*), and every fuzz seed
+//! (fuzz/seeds/<target>/*), through the fuzz targets' own checks (fuzz/src/lib.rs), without
+//! libFuzzer: a crash once found stays fixed. Each input must finish within 10 s.
+
+#[allow(dead_code)]
+#[path = "../fuzz/src/lib.rs"]
+mod fuzz;
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+fn replay(dir: &Path) -> usize {
+    let mut n = 0;
+    for target in fuzz::TARGETS {
+        let Ok(entries) = std::fs::read_dir(dir.join(target)) else {
+            continue;
+        };
+        let mut files: Vec<_> = entries.map(|e| e.unwrap().path()).collect();
+        files.sort();
+        for f in files {
+            let data = std::fs::read(&f).unwrap();
+            let t = Instant::now();
+            let r = std::panic::catch_unwind(|| fuzz::run(target, &data));
+            assert!(r.is_ok(), "{target}: {} panicked", f.display());
+            assert!(
+                t.elapsed() < Duration::from_secs(10),
+                "{target}: {} took {:?}",
+                f.display(),
+                t.elapsed()
+            );
+            n += 1;
+        }
+    }
+    n
+}
+
+#[test]
+fn fuzz_regressions() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let found = replay(&root.join("tests/data/fuzz"));
+    eprintln!("NOTE: replayed {found} fuzz regression inputs");
+}
+
+#[test]
+fn fuzz_seeds() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    assert!(replay(&root.join("fuzz/seeds")) >= 50);
+}
+
+/// Each crash the fuzzers found, by name, with the clean error it must now give (release
+/// builds have no overflow checks, so the replay above alone would not see an overflow).
+#[test]
+fn fuzz_crashes_give_clean_errors() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/fuzz");
+    let cases: &[(&str, curvetet::io::Format, &str)] = &[
+        // msh 4.1 binary: a node block count near u64::MAX overflowed `read + n`.
+        (
+            "read_msh/node_block_count_overflow.msh",
+            curvetet::io::Format::Msh,
+            "node blocks hold more nodes than the header says",
+        ),
+    ];
+    for (file, format, words) in cases {
+        let data = std::fs::read(dir.join(file)).unwrap();
+        match curvetet::io::read_bytes(&data, *format, file) {
+            Err(e @ curvetet::Error::Parse { .. }) => {
+                assert!(e.to_string().contains(words), "{file}: {e}")
+            }
+            Err(e) => panic!("{file}: expected a parse error, got {e}"),
+            Ok(_) => panic!("{file}: accepted"),
+        }
+    }
+}
