@@ -19,7 +19,7 @@ impl Mesher<'_> {
         let c = centroid3(fp[0], fp[1], fp[2]);
         let n = normalize(tri_normal(fp[0], fp[1], fp[2]));
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let h = regular_height(self.size_scale * self.size.at(c).clamp(0.55 * lf, 1.8 * lf));
+        let h = regular_height(self.size_at(c).clamp(0.55 * lf, 1.8 * lf));
         let a = axpy(c, h, n);
         let r = 3.0 * self.alpha * h;
         let mut out = String::new();
@@ -30,7 +30,7 @@ impl Mesher<'_> {
             f.v,
             if f.btri == u32::MAX { -1 } else { f.btri as i64 },
             c,
-            self.size_scale * self.size.at(c)
+            self.size_at(c)
         );
         let mut ids: Vec<u32> = self
             .vtree

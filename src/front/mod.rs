@@ -450,6 +450,11 @@ impl<'a> Mesher<'a> {
         Ok(())
     }
 
+    /// Target edge length at `x`: the size field times this run's factor.
+    fn size_at(&self, x: P3) -> f64 {
+        self.size_scale * self.size.at(x)
+    }
+
     fn face_pts(&self, fid: u32) -> [P3; 3] {
         let v = self.faces[fid as usize].v;
         [
@@ -499,7 +504,7 @@ impl<'a> Mesher<'a> {
             normalize(flat_n)
         };
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let l_field = self.size_scale * self.size.at(c);
+        let l_field = self.size_at(c);
         let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);
         let a = axpy(c, h, n);

@@ -47,7 +47,7 @@ impl Mesher<'_> {
         }
         // The ring grows with each repair here, but stays local: a few element sizes.
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let field = self.size_scale * self.size.at(c);
+        let field = self.size_at(c);
         let local = if count <= 2 {
             lf.min(field)
         } else {

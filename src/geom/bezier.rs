@@ -58,11 +58,10 @@ pub const BEZIER_INDEX: [[u8; 4]; 20] = [
 ];
 
 /// Coefficient slot of each ordered triple (i, j, k) (index 16 i + 4 j + k); the
-/// reference for the hand-expanded [`coeffs_from_columns`] (checked in the tests).
-#[cfg(test)]
-const TRIPLE_SLOT: [u8; 64] = triple_slots();
+/// reference for the hand-expanded [`coeffs_from_columns`] (checked in the tests), and
+/// the table the optimizer's Jacobian and its derivative use.
+pub(crate) const TRIPLE_SLOT: [u8; 64] = triple_slots();
 
-#[cfg(test)]
 const fn triple_slots() -> [u8; 64] {
     let mut out = [0u8; 64];
     let mut t = 0;
@@ -85,8 +84,7 @@ const fn triple_slots() -> [u8; 64] {
 }
 
 /// 1 / (number of ordered triples with the slot's multiset) = a! / 3!.
-#[cfg(test)]
-const SLOT_WEIGHT: [f64; 20] = {
+pub(crate) const SLOT_WEIGHT: [f64; 20] = {
     let mut w = [0.0; 20];
     let mut s = 0;
     while s < 20 {

@@ -329,11 +329,10 @@ pub fn tet10_volume(x: &[P3; 10]) -> f64 {
 mod tests {
     use super::super::shape::{straight_tet10, tet10_det_jacobian};
     use super::super::testutil::random_curved;
-    use super::super::vec3::{mid, normalize, tet_det};
+    use super::super::vec3::{add, mid, tet_det};
     use super::*;
     use rand::rngs::StdRng;
     use rand::{Rng, SeedableRng};
-    use std::collections::HashMap;
     use std::f64::consts::PI;
 
     fn fact(n: u32) -> f64 {
@@ -494,80 +493,12 @@ mod tests {
         assert!((tri6_volume_contribution(&x) - 1.0).abs() < 1e-14);
     }
 
-    /// A P2 icosphere: `level` 1-to-4 splits of the icosahedron, corners and mid nodes
-    /// projected onto the unit sphere (shared nodes, outward orientation), translated by
-    /// `shift`. Returns nodes, P2 triangles and the linear triangles.
-    fn p2_sphere(level: usize, shift: P3) -> (Vec<P3>, Vec<[u32; 6]>) {
-        let t = (1.0 + 5f64.sqrt()) / 2.0;
-        let mut v: Vec<P3> = [
-            [-1.0, t, 0.0],
-            [1.0, t, 0.0],
-            [-1.0, -t, 0.0],
-            [1.0, -t, 0.0],
-            [0.0, -1.0, t],
-            [0.0, 1.0, t],
-            [0.0, -1.0, -t],
-            [0.0, 1.0, -t],
-            [t, 0.0, -1.0],
-            [t, 0.0, 1.0],
-            [-t, 0.0, -1.0],
-            [-t, 0.0, 1.0],
-        ]
-        .iter()
-        .map(|p| normalize(*p))
-        .collect();
-        let mut f: Vec<[u32; 3]> = vec![
-            [0, 11, 5],
-            [0, 5, 1],
-            [0, 1, 7],
-            [0, 7, 10],
-            [0, 10, 11],
-            [1, 5, 9],
-            [5, 11, 4],
-            [11, 10, 2],
-            [10, 7, 6],
-            [7, 1, 8],
-            [3, 9, 4],
-            [3, 4, 2],
-            [3, 2, 6],
-            [3, 6, 8],
-            [3, 8, 9],
-            [4, 9, 5],
-            [2, 4, 11],
-            [6, 2, 10],
-            [8, 6, 7],
-            [9, 8, 1],
-        ];
-        let midpoint = |v: &mut Vec<P3>, cache: &mut HashMap<(u32, u32), u32>, a: u32, b: u32| {
-            let key = (a.min(b), a.max(b));
-            *cache.entry(key).or_insert_with(|| {
-                v.push(normalize(mid(v[a as usize], v[b as usize])));
-                (v.len() - 1) as u32
-            })
-        };
-        for _ in 0..level {
-            let mut cache = HashMap::new();
-            let mut g = Vec::with_capacity(f.len() * 4);
-            for [a, b, c] in f {
-                let ab = midpoint(&mut v, &mut cache, a, b);
-                let bc = midpoint(&mut v, &mut cache, b, c);
-                let ca = midpoint(&mut v, &mut cache, c, a);
-                g.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-            }
-            f = g;
-        }
-        let mut cache = HashMap::new();
-        let mut tris = Vec::with_capacity(f.len());
-        for [a, b, c] in f {
-            let ab = midpoint(&mut v, &mut cache, a, b);
-            let bc = midpoint(&mut v, &mut cache, b, c);
-            let ca = midpoint(&mut v, &mut cache, c, a);
-            tris.push([a, b, c, ab, bc, ca]);
-        }
+    /// The demo P2 icosphere (`level` 1-to-4 splits, every node on the unit sphere),
+    /// translated by `shift`.
+    fn p2_sphere(level: u32, shift: P3) -> (Vec<P3>, Vec<[u32; 6]>) {
+        let (mut v, tris) = crate::surface::demo::icosphere(level);
         for p in v.iter_mut() {
-            for d in 0..3 {
-                p[d] += shift[d];
-            }
+            *p = add(*p, shift);
         }
         (v, tris)
     }

@@ -119,10 +119,7 @@ pub fn icosphere(level: u32) -> (Vec<P3>, Vec<[u32; 6]>) {
         [8, 6, 7],
         [9, 8, 1],
     ];
-    let unit = |p: [f64; 3]| {
-        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        [p[0] / n, p[1] / n, p[2] / n]
-    };
+    let unit = crate::geom::vec3::normalize;
     for p in v.iter_mut() {
         *p = unit(*p);
     }

@@ -11,7 +11,7 @@
 // Index loops mirror the formulas (several arrays per index).
 #![allow(clippy::needless_range_loop)]
 
-use crate::geom::bezier::BEZIER_INDEX;
+use crate::geom::bezier::{SLOT_WEIGHT, TRIPLE_SLOT};
 use crate::geom::vec3::{cross, dot, sub, P3};
 
 /// Column coefficient `c_d[j]` as (node, integer weight) terms, Gmsh node order (corners
@@ -39,51 +39,12 @@ const COLS: [[[(usize, f64); 4]; 4]; 3] = [
     ],
 ];
 
-/// Coefficient slot of the ordered triple (i, j, k) at index 16 i + 4 j + k.
-const SLOT: [u8; 64] = {
-    let mut out = [0u8; 64];
-    let mut t = 0;
-    while t < 64 {
-        let mut a = [0u8; 4];
-        a[t / 16] += 1;
-        a[(t / 4) % 4] += 1;
-        a[t % 4] += 1;
-        let mut s = 0;
-        while s < 20 {
-            let b = BEZIER_INDEX[s];
-            if b[0] == a[0] && b[1] == a[1] && b[2] == a[2] && b[3] == a[3] {
-                out[t] = s as u8;
-            }
-            s += 1;
-        }
-        t += 1;
-    }
-    out
-};
-
-/// 1 / (number of ordered triples of the slot's multiset).
-const WEIGHT: [f64; 20] = {
-    let mut w = [0.0; 20];
-    let mut s = 0;
-    while s < 20 {
-        w[s] = if s < 4 {
-            1.0
-        } else if s < 16 {
-            1.0 / 3.0
-        } else {
-            1.0 / 6.0
-        };
-        s += 1;
-    }
-    w
-};
-
 /// The Jacobian columns of one element (what [`backprop`] needs).
 pub(crate) struct JacTape {
     c: [[P3; 4]; 3],
 }
 
-/// Coefficients of det J of `x` (in [`BEZIER_INDEX`] order) and the tape for
+/// Coefficients of det J of `x` (in [`crate::geom::bezier::BEZIER_INDEX`] order) and the tape for
 /// [`backprop`].
 #[inline]
 pub(crate) fn bezier_forward(x: &[P3; 10]) -> ([f64; 20], JacTape) {
@@ -100,11 +61,11 @@ pub(crate) fn bezier_forward(x: &[P3; 10]) -> ([f64; 20], JacTape) {
     for i in 0..4 {
         for j in 0..4 {
             for k in 0..4 {
-                b[SLOT[16 * i + 4 * j + k] as usize] += dot(c[0][i], x12[j][k]);
+                b[TRIPLE_SLOT[16 * i + 4 * j + k] as usize] += dot(c[0][i], x12[j][k]);
             }
         }
     }
-    for (v, w) in b.iter_mut().zip(WEIGHT.iter()) {
+    for (v, w) in b.iter_mut().zip(SLOT_WEIGHT.iter()) {
         *v *= w;
     }
     (b, JacTape { c })
@@ -116,12 +77,12 @@ pub(crate) fn backprop(tape: &JacTape, gb: &[f64; 20], gx: &mut [P3; 10]) {
     let c = &tape.c;
     let mut gs = [0.0; 20];
     for s in 0..20 {
-        gs[s] = gb[s] * WEIGHT[s];
+        gs[s] = gb[s] * SLOT_WEIGHT[s];
     }
     // W_ijk = gs[slot(i, j, k)] is symmetric in (i, j, k). With U = Σ_k W_ijk c_2[k]:
     // ∂F/∂c_0[i] = Σ_j c_1[j] × U_ij, and cyclically for c_1 and c_2 (register-friendly
     // two-step contractions instead of 64 accumulations into memory).
-    let w = |i: usize, j: usize, k: usize| gs[SLOT[16 * i + 4 * j + k] as usize];
+    let w = |i: usize, j: usize, k: usize| gs[TRIPLE_SLOT[16 * i + 4 * j + k] as usize];
     let mut g = [[[0.0; 3]; 4]; 3];
     for i in 0..4 {
         let (mut a0, mut a1, mut a2) = ([0.0; 3], [0.0; 3], [0.0; 3]);
