@@ -199,12 +199,7 @@ fn sphere_curves_then_meshes() {
 
 /// Curve, then mesh the sharp-featured surfaces end to end: certified valid, the curved
 /// boundary kept.
-///
-/// Ignored (issue 7 stays open on it): the screw passes; the hinge's front now closes, but
-/// its optimized mesh keeps one element that is not certified valid (2026-11-23:
-/// "invalid mesh: 1 elements are not certified valid"). Un-ignore when it meshes.
 #[test]
-#[ignore = "hinge_lin: one element not certified valid after optimization"]
 fn hinge_and_screw_curve_then_mesh() {
     for name in ["hinge", "screw"] {
         let (_, s, _) = curve(name, &CurveOptions::default());

@@ -439,6 +439,33 @@ impl JacobianBounds {
     }
 }
 
+/// Can moving the free mid nodes (`free_mid[k]` for edge `TET10_EDGES[k]`; corners fixed)
+/// possibly make the tet `x` valid? False when a Bernstein coefficient that none of them
+/// affects is not positive (beyond rounding): the column coefficients at corner j depend
+/// only on the mid nodes of the edges at j, so a coefficient whose multi-index touches only
+/// corners with every incident edge fixed keeps its value whatever the free nodes do (a
+/// corner coefficient is det J at that corner). A necessary condition, cheap enough for
+/// the front to ask before it accepts a tet for the optimizer to untangle.
+pub fn fixed_coefficients_positive(x: &[P3; 10], free_mid: [bool; 6]) -> bool {
+    let mut corner_fixed = [true; 4];
+    for (k, [a, b]) in TET10_EDGES.iter().enumerate() {
+        if free_mid[k] {
+            corner_fixed[*a] = false;
+            corner_fixed[*b] = false;
+        }
+    }
+    if !corner_fixed.iter().any(|&f| f) {
+        return true;
+    }
+    let lj = LinearJacobian::new(x);
+    let tau = lj.rounding_margin();
+    let b = lj.bezier();
+    BEZIER_INDEX.iter().zip(b.iter()).all(|(a, &v)| {
+        let fixed = (0..4).all(|j| a[j] == 0 || corner_fixed[j]);
+        !fixed || v > tau
+    })
+}
+
 /// Proves or disproves det J > 0 on the whole element: one set of Bernstein coefficients
 /// decides almost every element; inconclusive ones (some coefficient <= 0 while the
 /// sampled values are positive) are resolved by adaptive red refinement, up to

@@ -16,6 +16,7 @@ mod lbfgs;
 mod objective;
 mod patch;
 
+use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::{dist, mid, P3};
 use crate::mesh::quality::tet_nodes;
@@ -331,7 +332,13 @@ fn evaluate(
         let s = objective::score(&xe, enough);
         lo = lo.min(s);
         if with_skew {
-            sk = sk.max(skew(&xe));
+            // An inverted corner tet counts as the worst skewness: the final check wants
+            // every corner tet positive, whatever the curved Jacobian says.
+            sk = if orient3d(xe[0], xe[1], xe[2], xe[3]) > 0 {
+                sk.max(skew(&xe))
+            } else {
+                f64::INFINITY
+            };
         }
         out.push(s);
     }

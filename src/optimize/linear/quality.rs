@@ -3,11 +3,13 @@
 //! [0, 1], for a tet that is positive (exact) and, when it touches a curved boundary edge,
 //! certified valid as a P2 element. A positive tet that is not P2-valid scores in
 //! [−1, −0.5] by its scaled-Jacobian lower bound (so operations may improve it but never
-//! create one); a non-positive tet scores −∞.
+//! create one); a non-positive tet, or one no placement of its interior mid nodes can make
+//! valid, scores −∞.
 
-use crate::geom::bezier::{certify, jacobian_bounds, LinearJacobian};
+use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds, LinearJacobian};
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG};
+use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
 use crate::optimize::dual::{dcross, ddot, dsub, D3, DP};
 use crate::optimize::Boundary;
@@ -50,6 +52,13 @@ impl ElementQuality {
                 .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
             let valid = (blo > lj.rounding_margin() && blo.is_finite()) || certify(&x).is_valid();
             if !valid {
+                // Invalid whatever the high-order stage does with the interior mid
+                // nodes (a coefficient only boundary nodes set is not positive): as bad
+                // as an inverted tet, so no operation creates one.
+                let free_mid = TET10_EDGES.map(|[i, j]| bnd.edge_mid(v[i], v[j]).is_none());
+                if !fixed_coefficients_positive(&x, free_mid) {
+                    return f64::NEG_INFINITY;
+                }
                 let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
                 let sj = if sj.is_nan() {
                     -1.0
