@@ -908,6 +908,35 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     #[test]
+    fn fixed_coefficients_decide_what_free_mid_nodes_cannot_fix() {
+        let unit = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let mut x = straight_tet10(unit);
+        assert!(fixed_coefficients_positive(&x, [false; 6]));
+        // Mid node of edge 0-1 pulled back past corner 0: det J < 0 at corner 0.
+        x[4] = [-0.5, 0.0, 0.0];
+        assert!(!certify(&x).is_valid());
+        assert!(jacobian_bezier(&x)[0] < 0.0);
+        // Nothing free, or only edges away from corners 0 and 1 free: unfixable.
+        assert!(!fixed_coefficients_positive(&x, [false; 6]));
+        assert!(!fixed_coefficients_positive(
+            &x,
+            [false, false, false, false, true, false]
+        ));
+        // Edge 0-1's own mid node free: every coefficient left fixed is positive.
+        let mut free = [false; 6];
+        free[0] = true;
+        assert!(fixed_coefficients_positive(&x, free));
+        // Which is right: putting that mid node back makes the tet valid.
+        x[4] = [0.5, 0.0, 0.0];
+        assert!(certify(&x).is_valid());
+    }
+
+    #[test]
     fn bezier_index_table_is_consistent() {
         // Every multi-index of degree 3 exactly once; each ordered triple maps to its slot.
         let mut seen = [false; 20];
