@@ -2,7 +2,7 @@
 //! and report. Each stage hands the next a value; nothing reaches back.
 
 use crate::front::size::{regular_edge_from_area, SizeField};
-use crate::front::{run_front, FrontStats};
+use crate::front::{run_front, FrontStats, RESTARTS};
 use crate::geom::quadrature::tri6_area;
 use crate::geom::shape::TET10_EDGES;
 use crate::mesh::quality::{uncertified, QualityReport};
@@ -114,39 +114,64 @@ fn generate_inner(
     let size_value = size.min_size();
     times.size_field = t.elapsed().as_secs_f64();
 
-    let t = Instant::now();
-    let front = run_front(surface.nodes(), surface.triangles(), opts, size, progress)?;
-    times.front = t.elapsed().as_secs_f64();
-
-    let mut ostats = OptimizeStats::default();
     let bnd = Boundary::new(surface.nodes().len(), surface.triangles());
-    let (pts, tets) = if opts.optimize {
+    // Front, linear stage, assembly, high-order stage; when the optimizer leaves an
+    // element it could not untangle, again from the front's next restart configuration
+    // (another search radius or size changes every choice the greedy front makes, as for a
+    // front that cannot close). Bounded by RESTARTS; the last attempt's mesh goes to the
+    // final check whatever it is.
+    let mut first = 0;
+    let (front_stats, mesh, ostats) = loop {
         let t = Instant::now();
-        let (pts, tets, st) = improve_linear(front.pts, front.tets, &bnd, &LinearParams::default());
-        ostats.linear = st;
-        ostats.time_linear = t.elapsed().as_secs_f64();
-        (pts, tets)
-    } else {
-        (front.pts, front.tets)
+        let front = run_front(
+            surface.nodes(),
+            surface.triangles(),
+            opts,
+            &size,
+            first,
+            progress,
+        )?;
+        times.front += t.elapsed().as_secs_f64();
+
+        let mut ostats = OptimizeStats::default();
+        let (pts, tets) = if opts.optimize {
+            let t = Instant::now();
+            let (pts, tets, st) =
+                improve_linear(front.pts, front.tets, &bnd, &LinearParams::default());
+            ostats.linear = st;
+            ostats.time_linear = t.elapsed().as_secs_f64();
+            (pts, tets)
+        } else {
+            (front.pts, front.tets)
+        };
+
+        let t = Instant::now();
+        let mut mesh = build::assemble(
+            &pts,
+            &tets,
+            surface.nodes().len(),
+            surface.triangles(),
+            surface.tags(),
+        );
+        times.assemble += t.elapsed().as_secs_f64();
+
+        if opts.optimize {
+            let t = Instant::now();
+            ostats.high_order =
+                pool.install(|| optimize_high_order(&mut mesh, &bnd, &HighOrderParams::default()));
+            ostats.time_high_order = t.elapsed().as_secs_f64();
+        }
+        times.optimize += ostats.time_linear + ostats.time_high_order;
+        let next = front.stats.restarts as usize + 1;
+        if opts.optimize && ostats.high_order.invalid[1] > 0 && next < RESTARTS.len() {
+            if progress(0.0, "front (restart: elements left invalid)") {
+                return Err(Error::Cancelled);
+            }
+            first = next;
+            continue;
+        }
+        break (front.stats, mesh, ostats);
     };
-
-    let t = Instant::now();
-    let mut mesh = build::assemble(
-        &pts,
-        &tets,
-        surface.nodes().len(),
-        surface.triangles(),
-        surface.tags(),
-    );
-    times.assemble = t.elapsed().as_secs_f64();
-
-    if opts.optimize {
-        let t = Instant::now();
-        ostats.high_order =
-            pool.install(|| optimize_high_order(&mut mesh, &bnd, &HighOrderParams::default()));
-        ostats.time_high_order = t.elapsed().as_secs_f64();
-    }
-    times.optimize = ostats.time_linear + ostats.time_high_order;
     // Tests only (see INJECT_FAULT_ENV): corrupt the mesh just before the final check.
     let mesh = inject_fault(mesh, surface.nodes().len());
 
@@ -195,7 +220,7 @@ fn generate_inner(
     Ok(Generated {
         mesh,
         report,
-        front: front.stats,
+        front: front_stats,
         times,
         optimize: ostats,
         size: size_value,

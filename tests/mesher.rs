@@ -76,12 +76,6 @@ fn hinge() {
 fn alphas_and_uniform_size() {
     for name in ["sphere", "torus", "tube", "lv", "screw", "hinge"] {
         for alpha in [1.2, 1.5, 2.0, 2.5] {
-            // Known failure, issue 3 stays open on it: at alpha 1.2 the hinge's optimized
-            // mesh keeps one tet whose curved shape is valid but whose straight-sided corner
-            // tet is inverted, which the final check rejects (InvalidMesh).
-            if name == "hinge" && alpha == 1.2 {
-                continue;
-            }
             mesh_and_check(
                 name,
                 &Options {

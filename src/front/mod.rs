@@ -59,7 +59,8 @@ pub struct FrontStats {
     /// Tets accepted as a last resort with a non-positive P2 Jacobian (linear-valid, with
     /// a free mid node), left for the high-order optimizer to untangle.
     pub p2_invalid: u64,
-    /// Whole-front restarts after the front could not be closed (see [`RESTARTS`]).
+    /// Whole-front restarts (see [`RESTARTS`]): the front could not be closed, or the
+    /// optimizer left an element of the previous attempt invalid.
     pub restarts: u32,
     /// Search radius factor of the run that succeeded.
     pub alpha: f64,
@@ -844,18 +845,21 @@ fn curved_valid(x: &[P3; 10]) -> bool {
 pub const RESTARTS: [(f64, f64); 4] = [(1.0, 1.0), (0.8, 1.0), (1.3, 1.0), (1.0, 0.85)];
 
 /// Run the front on a checked surface's arrays, restarting per [`RESTARTS`] when it
-/// cannot close.
+/// cannot close, starting with attempt `first` (a caller whose later stages refuse a
+/// front's result asks for the next configuration; `stats.restarts` says which one
+/// succeeded).
 pub fn run_front(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
     opts: &Options,
-    size: SizeField,
+    size: &SizeField,
+    first: usize,
     progress: Progress,
 ) -> Result<FrontOutput> {
     let mut failures = Vec::new();
     let mut last_partial = None;
-    for (attempt, &(fa, fs)) in RESTARTS.iter().enumerate() {
-        let mut m = Mesher::new(surf_nodes, surf_tris, opts, &size);
+    for (attempt, &(fa, fs)) in RESTARTS.iter().enumerate().skip(first) {
+        let mut m = Mesher::new(surf_nodes, surf_tris, opts, size);
         m.alpha = opts.alpha * fa;
         m.size_scale = fs;
         m.stats.restarts = attempt as u32;
@@ -889,7 +893,7 @@ pub fn run_front(
     Err(Error::MeshingFailed {
         msg: format!(
             "{} attempts failed: {}",
-            RESTARTS.len(),
+            failures.len(),
             failures.join("; ")
         ),
         partial: last_partial,

@@ -489,11 +489,15 @@ mod ceiling {
         let surf = crate::io::read_surface(std::path::Path::new(&path)).unwrap();
         let opts = crate::Options::default();
         let size = crate::generate::size_field(&surf, &opts);
-        let f =
-            crate::front::run_front(surf.nodes(), surf.triangles(), &opts, size, &mut |_, _| {
-                false
-            })
-            .unwrap();
+        let f = crate::front::run_front(
+            surf.nodes(),
+            surf.triangles(),
+            &opts,
+            &size,
+            0,
+            &mut |_, _| false,
+        )
+        .unwrap();
         let bnd = Boundary::new(surf.nodes().len(), surf.triangles());
         let (pts, tets, _) =
             crate::optimize::improve_linear(f.pts, f.tets, &bnd, &Default::default());
