@@ -183,7 +183,10 @@ impl<'a> Mesher<'a> {
             }
         }
         let mean_edge = edge_len_sum / (3 * surf_tris.len()).max(1) as f64;
-        let cell = mean_edge.max(edge_len_max / 8.0);
+        // Cells about the size of a query box (a tet's box widened by the proximity
+        // floors, 2-3 edge lengths): twice the mean edge was 15-20% faster on the front
+        // than one mean edge (100k-tet torus; fewer cells visited, fewer duplicates).
+        let cell = 2.0 * mean_edge.max(edge_len_max / 8.0);
         let mut m = Mesher {
             opts,
             surf_nodes,
