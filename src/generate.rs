@@ -115,13 +115,14 @@ fn generate_inner(
     times.size_field = t.elapsed().as_secs_f64();
 
     let bnd = Boundary::new(surface.nodes().len(), surface.triangles());
-    // Front, linear stage, assembly, high-order stage; when the optimizer leaves an
-    // element it could not untangle, again from the front's next restart configuration
-    // (another search radius or size changes every choice the greedy front makes, as for a
-    // front that cannot close). Bounded by RESTARTS; the last attempt's mesh goes to the
-    // final check whatever it is.
+    // Front, linear stage, assembly, high-order stage, final check; when the check finds
+    // elements the optimizer could not untangle (in a conforming mesh), again from the
+    // front's next restart configuration (another search radius or size changes every
+    // choice the greedy front makes, as for a front that cannot close). Bounded by
+    // RESTARTS; the last attempt's result stands, whatever it is.
     let mut first = 0;
-    let (front_stats, mesh, ostats) = loop {
+    let mut pass = 0;
+    let (front_stats, mesh, ostats, conf, bad) = loop {
         let t = Instant::now();
         let front = run_front(
             surface.nodes(),
@@ -162,25 +163,26 @@ fn generate_inner(
             ostats.time_high_order = t.elapsed().as_secs_f64();
         }
         times.optimize += ostats.time_linear + ostats.time_high_order;
+        // Tests only (see INJECT_FAULT_ENV): corrupt the mesh just before the final check.
+        let mesh = inject_fault(mesh, surface.nodes().len(), pass);
+        pass += 1;
+
+        if progress(1.0, "certify") {
+            return Err(Error::Cancelled);
+        }
+        let t = Instant::now();
+        let (conf, bad) = pool.install(|| (check::check_conformity(&mesh), uncertified(&mesh)));
+        times.certify += t.elapsed().as_secs_f64();
         let next = front.stats.restarts as usize + 1;
-        if opts.optimize && ostats.high_order.invalid[1] > 0 && next < RESTARTS.len() {
+        if opts.optimize && conf.is_ok() && !bad.is_empty() && next < RESTARTS.len() {
             if progress(0.0, "front (restart: elements left invalid)") {
                 return Err(Error::Cancelled);
             }
             first = next;
             continue;
         }
-        break (front.stats, mesh, ostats);
+        break (front.stats, mesh, ostats, conf, bad);
     };
-    // Tests only (see INJECT_FAULT_ENV): corrupt the mesh just before the final check.
-    let mesh = inject_fault(mesh, surface.nodes().len());
-
-    if progress(1.0, "certify") {
-        return Err(Error::Cancelled);
-    }
-    let t = Instant::now();
-    let (conf, bad) = pool.install(|| (check::check_conformity(&mesh), uncertified(&mesh)));
-    times.certify = t.elapsed().as_secs_f64();
     let conf = match conf {
         Ok(c) => c,
         Err(Error::InvalidMesh { elements, msg, .. }) => {
@@ -231,10 +233,12 @@ fn generate_inner(
 /// final check, to prove the check catches it (`Error::InvalidMesh`, C status
 /// `CURVETET_ERR_INVALID_MESH`, CLI exit 6): `invert[:T]` swaps two corners of tet `T`
 /// (default 0; conformity fails), `jacobian[:T]` moves an interior mid node of tet `T` next
-/// to a corner (the mesh stays conforming but tet `T` is not certified valid). Tests only.
+/// to a corner (the mesh stays conforming but tet `T` is not certified valid), and
+/// `jacobian-once[:T]` does so on the first attempt only (the restart must then deliver a
+/// certified mesh). Tests only.
 pub const INJECT_FAULT_ENV: &str = "CURVETET_INJECT_INVALID_MESH";
 
-fn inject_fault(mut mesh: TetMesh, surface_nodes: usize) -> TetMesh {
+fn inject_fault(mut mesh: TetMesh, surface_nodes: usize, pass: usize) -> TetMesh {
     let Ok(spec) = std::env::var(INJECT_FAULT_ENV) else {
         return mesh;
     };
@@ -251,7 +255,7 @@ fn inject_fault(mut mesh: TetMesh, surface_nodes: usize) -> TetMesh {
             e.swap(5, 6);
             e.swap(7, 9);
         }
-        "jacobian" => {
+        "jacobian" | "jacobian-once" if kind == "jacobian" || pass == 0 => {
             let e = mesh.tets[t];
             if let Some(k) = (0..6).find(|&k| e[4 + k] as usize >= surface_nodes) {
                 let (a, b) = (

@@ -3,7 +3,8 @@
 //! `curvetet::generate::INJECT_FAULT_ENV`), and the check must catch it through every door:
 //! the library (`Error::InvalidMesh` naming the element, the mesh kept for inspection), the
 //! C ABI (`CURVETET_ERR_INVALID_MESH`, no mesh handed out) and the CLI (exit 6, no output
-//! file unless `--keep-partial`).
+//! file unless `--keep-partial`). A fault on the first attempt only must be cured by the
+//! restart with the front's next configuration.
 //!
 //! One test function: the variable is process-wide.
 
@@ -97,6 +98,18 @@ fn corrupted_meshes_are_never_returned() {
     expect_invalid(&s, "invert:7", 7, "inverted");
     expect_invalid(&s, "jacobian:11", 11, "not certified valid");
     expect_invalid(&s, "jacobian", 0, "not certified valid");
+
+    // Elements left uncertified on the first attempt only: the pipeline runs again from
+    // the front's next configuration (alpha x 0.8) and delivers a certified mesh.
+    std::env::set_var(INJECT_FAULT_ENV, "jacobian-once:5");
+    let g = generate(&s, &Options::default());
+    std::env::remove_var(INJECT_FAULT_ENV);
+    let g = g.expect("the restart delivers a certified mesh");
+    assert_eq!(g.front.restarts, 1);
+    assert_eq!(g.front.alpha, 0.8 * Options::default().alpha);
+    assert_eq!(g.report.num_invalid, 0);
+    assert!(curvetet::mesh::quality::uncertified(&g.mesh).is_empty());
+    assert_eq!(clean.front.restarts, 0);
 
     // C ABI.
     std::env::set_var(INJECT_FAULT_ENV, "jacobian:3");
