@@ -29,7 +29,8 @@ pub enum SurfaceDefect {
     NonManifoldVertex,
     /// Neighbouring triangles have opposite orientations (or the shells disagree).
     InconsistentOrientation,
-    /// Two triangles share an edge but not its mid-edge node, or a mid node is shared wrongly.
+    /// Two triangles share an edge but not its mid-edge node, a mid node is shared wrongly,
+    /// or a mid node lies more than an edge length from its edge's midpoint.
     MidNodeMismatch,
     /// A triangle has zero area (collinear corners).
     DegenerateTriangle,

@@ -124,6 +124,43 @@ pub fn min_normal_cosine_of(x: &[P3; 6]) -> NormalSample {
     NormalSample::MinCos(best.0, best.1)
 }
 
+/// Largest distance of a mid node from its edge's midpoint, in edge lengths. A circular
+/// arc of a whole half turn has its mid node half an edge length off (0.5): real curved
+/// surfaces stay far below; beyond 1 the node belongs to no sensible edge.
+pub const MAX_MID_OFFSET: f64 = 1.0;
+
+/// Every mid node within [`MAX_MID_OFFSET`] edge lengths of its edge's midpoint.
+pub fn check_mid_offsets(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
+    let bad = tris.par_iter().enumerate().find_map_first(|(t, tri)| {
+        (0..3).find_map(|k| {
+            let (a, b, m) = (
+                nodes[tri[k] as usize],
+                nodes[tri[(k + 1) % 3] as usize],
+                nodes[tri[3 + k] as usize],
+            );
+            let len = norm(sub(b, a));
+            let c: P3 = std::array::from_fn(|d| 0.5 * (a[d] + b[d]));
+            let off = norm(sub(m, c));
+            (off > MAX_MID_OFFSET * len).then_some((t, k, off / len))
+        })
+    });
+    if let Some((t, k, r)) = bad {
+        let tri = &tris[t];
+        return Err(Error::surface(
+            SurfaceDefect::MidNodeMismatch,
+            format!(
+                "{}: mid node {} of edge ({}, {}) lies {r:.3e} edge lengths from the edge's \
+                 midpoint (at most {MAX_MID_OFFSET}): it is not a mid node of that edge",
+                describe::tri(t, tri),
+                tri[3 + k],
+                tri[k],
+                tri[(k + 1) % 3]
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// No folded curved triangle: every lattice cosine > 0.
 pub fn check_folded(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
     let bad = tris

@@ -16,7 +16,9 @@
 //!    coordinates ([`DuplicateNode`](SurfaceDefect::DuplicateNode), by sorting).
 //! 4. [`topology`]: the corner-edge rule (see there) — non-manifold edges, open edges,
 //!    edges used twice in one direction, mid-node sharing; then one fan per vertex.
-//! 5. [`geometry`]: exactly collinear corners; folded curved triangles (order-6 lattice).
+//! 5. [`geometry`]: exactly collinear corners; a mid node more than an edge length from
+//!    its edge's midpoint ([`MidNodeMismatch`](SurfaceDefect::MidNodeMismatch)); folded
+//!    curved triangles (order-6 lattice).
 //! 6. [`intersect`]: exact self-intersection of the chord triangles, then of the four flat
 //!    sub-triangles of every curved triangle (both are errors; see there why).
 //! 7. [`orientation`]: per shell, the exact sign of the enclosed chord volume and the
@@ -118,6 +120,7 @@ impl Surface {
         coords::check_duplicates(&nodes)?;
         let topo = topology::Topology::build(&nodes, &tris)?;
         geometry::check_degenerate(&nodes, &tris)?;
+        geometry::check_mid_offsets(&nodes, &tris)?;
         geometry::check_folded(&nodes, &tris)?;
         intersect::check_intersections(&nodes, &tris)?;
         let mut warnings = Vec::new();

@@ -580,11 +580,41 @@ fn folded_curved_triangle() {
         msg.contains("min cos(curved normal, chord normal) = -"),
         "{msg}"
     );
-    // Pushed through along the normal, far: the patch turns inside out near the edge.
+    // Pushed through along the normal: the patch turns inside out near the edge.
+    let mut s = octahedron(1.0);
+    let m = s.tris[0][3];
+    s.nodes[m as usize] = scale(s.nodes[m as usize], -0.7);
+    assert_defect(&s, SurfaceDefect::FoldedTriangle, &["triangle 0 "]);
+}
+
+#[test]
+fn mid_node_far_from_its_edge() {
+    // Farther than an edge length from the edge's midpoint (here 2.7 edge lengths
+    // through the centre; the fuzzer's case was 1e58 on a model scaled to 1e-58, which
+    // the fold sampling let through and the volume could not be computed for).
     let mut s = octahedron(1.0);
     let m = s.tris[0][3];
     s.nodes[m as usize] = scale(s.nodes[m as usize], -2.0);
-    assert_defect(&s, SurfaceDefect::FoldedTriangle, &["triangle 0 "]);
+    let msg = assert_defect(
+        &s,
+        SurfaceDefect::MidNodeMismatch,
+        &["triangle 0 ", "edge lengths from the edge's midpoint"],
+    );
+    assert!(msg.contains(&format!("mid node {m} ")), "{msg}");
+    let mut s = icosahedron().moved(|p| scale(p, 1e-58));
+    let m = s.tris[3][4] as usize;
+    s.nodes[m] = [0.75, 0.0, -2.0];
+    assert_defect(&s, SurfaceDefect::MidNodeMismatch, &["mid node"]);
+    // Just under the limit is not this defect (a half-turn arc is 0.5).
+    let mut s = octahedron(1.0);
+    let (a, b, m) = (s.tris[0][0], s.tris[0][1], s.tris[0][3]);
+    let (pa, pb) = (s.nodes[a as usize], s.nodes[b as usize]);
+    let c = scale(add(pa, pb), 0.5);
+    let len = dist2(pa, pb).sqrt();
+    s.nodes[m as usize] = add(c, scale(normalize(c), 0.99 * len));
+    if let Err(Error::InvalidSurface { kind, .. }) = s.check() {
+        assert_ne!(kind, SurfaceDefect::MidNodeMismatch);
+    }
 }
 
 // ---------------------------------------------------------------- intersections
