@@ -440,26 +440,21 @@ impl JacobianBounds {
 }
 
 /// Can moving the free mid nodes (`free_mid[k]` for edge `TET10_EDGES[k]`; corners fixed)
-/// possibly make the tet `x` valid? False when a Bernstein coefficient that none of them
-/// affects is not positive (beyond rounding): the column coefficients at corner j depend
-/// only on the mid nodes of the edges at j, so a coefficient whose multi-index touches only
-/// corners with every incident edge fixed keeps its value whatever the free nodes do (a
-/// corner coefficient is det J at that corner). A necessary condition, cheap enough for
-/// the front to ask before it accepts a tet for the optimizer to untangle.
-pub fn fixed_coefficients_positive(x: &[P3; 10], free_mid: [bool; 6]) -> bool {
+/// possibly make a tet valid whose det J has the Bernstein coefficients `b` (rounding
+/// margin `tau`, see [`LinearJacobian::rounding_margin`])? False when a coefficient that
+/// none of them affects is not above `tau`: the column coefficients at corner j depend
+/// only on the mid nodes of the edges at j, so a coefficient whose multi-index touches
+/// only corners with every incident edge fixed keeps its value whatever the free nodes do
+/// (a corner coefficient is det J at that corner). A necessary condition; the linear
+/// optimization stage asks it of the P2-invalid tets it would create.
+pub fn fixed_coefficients_positive(b: &[f64; 20], tau: f64, free_mid: [bool; 6]) -> bool {
     let mut corner_fixed = [true; 4];
-    for (k, [a, b]) in TET10_EDGES.iter().enumerate() {
+    for (k, [e0, e1]) in TET10_EDGES.iter().enumerate() {
         if free_mid[k] {
-            corner_fixed[*a] = false;
-            corner_fixed[*b] = false;
+            corner_fixed[*e0] = false;
+            corner_fixed[*e1] = false;
         }
     }
-    if !corner_fixed.iter().any(|&f| f) {
-        return true;
-    }
-    let lj = LinearJacobian::new(x);
-    let tau = lj.rounding_margin();
-    let b = lj.bezier();
     BEZIER_INDEX.iter().zip(b.iter()).all(|(a, &v)| {
         let fixed = (0..4).all(|j| a[j] == 0 || corner_fixed[j]);
         !fixed || v > tau
@@ -915,22 +910,23 @@ mod tests {
             [0.0, 1.0, 0.0],
             [0.0, 0.0, 1.0],
         ];
+        let fixed_ok = |x: &[P3; 10], free: [bool; 6]| {
+            let lj = LinearJacobian::new(x);
+            fixed_coefficients_positive(&lj.bezier(), lj.rounding_margin(), free)
+        };
         let mut x = straight_tet10(unit);
-        assert!(fixed_coefficients_positive(&x, [false; 6]));
+        assert!(fixed_ok(&x, [false; 6]));
         // Mid node of edge 0-1 pulled back past corner 0: det J < 0 at corner 0.
         x[4] = [-0.5, 0.0, 0.0];
         assert!(!certify(&x).is_valid());
         assert!(jacobian_bezier(&x)[0] < 0.0);
         // Nothing free, or only edges away from corners 0 and 1 free: unfixable.
-        assert!(!fixed_coefficients_positive(&x, [false; 6]));
-        assert!(!fixed_coefficients_positive(
-            &x,
-            [false, false, false, false, true, false]
-        ));
+        assert!(!fixed_ok(&x, [false; 6]));
+        assert!(!fixed_ok(&x, [false, false, false, false, true, false]));
         // Edge 0-1's own mid node free: every coefficient left fixed is positive.
         let mut free = [false; 6];
         free[0] = true;
-        assert!(fixed_coefficients_positive(&x, free));
+        assert!(fixed_ok(&x, free));
         // Which is right: putting that mid node back makes the tet valid.
         x[4] = [0.5, 0.0, 0.0];
         assert!(certify(&x).is_valid());

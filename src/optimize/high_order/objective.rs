@@ -300,8 +300,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn gradient_matches_finite_differences() {
+    /// A tet with one mid node (edge 0-1) off its edge.
+    fn curved_tet() -> [P3; 10] {
         let c = [
             [0.0, 0.0, 0.0],
             [1.0, 0.1, 0.0],
@@ -310,6 +310,38 @@ mod tests {
         ];
         let mut x = crate::geom::shape::straight_tet10(c);
         x[4][2] += 0.05;
+        x
+    }
+
+    #[test]
+    #[ignore = "timing; run in release with --ignored --nocapture"]
+    fn eval_cost() {
+        let x = curved_tet();
+        let mut elems = Vec::new();
+        for _ in 0..100 {
+            let var = [FIXED, FIXED, FIXED, 0, 1, 2, 3, 4, 5, 6];
+            elems.push(PatchElem::new(x, var));
+        }
+        let obj = Objective {
+            elems: &elems,
+            eps: -0.5,
+            last_ratio: Default::default(),
+        };
+        let mut v = vec![0.01; 21];
+        v[..3].copy_from_slice(&x[3]);
+        let mut g = vec![0.0; 21];
+        let t = std::time::Instant::now();
+        let mut s = 0.0;
+        for _ in 0..2000 {
+            s += obj.eval(&v, &mut g);
+        }
+        let dt = t.elapsed().as_secs_f64();
+        println!("{:.1} ns per element eval ({s})", dt / 200000.0 * 1e9);
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences() {
+        let mut x = curved_tet();
         x[9][0] -= 0.04;
         // Corner 3 and mids 5 and 9 free; mid 9 sits on edge (3, 1).
         let e = PatchElem::new(
@@ -352,43 +384,5 @@ mod tests {
                 g[i]
             );
         }
-    }
-}
-
-#[cfg(test)]
-mod bench {
-    use super::*;
-
-    #[test]
-    #[ignore]
-    fn eval_cost() {
-        let c = [
-            [0.0, 0.0, 0.0],
-            [1.0, 0.1, 0.0],
-            [0.2, 0.9, 0.1],
-            [0.3, 0.2, 0.8],
-        ];
-        let mut x = crate::geom::shape::straight_tet10(c);
-        x[4][2] += 0.05;
-        let mut elems = Vec::new();
-        for _ in 0..100 {
-            let var = [FIXED, FIXED, FIXED, 0, 1, 2, 3, 4, 5, 6];
-            elems.push(PatchElem::new(x, var));
-        }
-        let obj = Objective {
-            elems: &elems,
-            eps: -0.5,
-            last_ratio: Default::default(),
-        };
-        let mut v = vec![0.01; 21];
-        v[..3].copy_from_slice(&x[3]);
-        let mut g = vec![0.0; 21];
-        let t = std::time::Instant::now();
-        let mut s = 0.0;
-        for _ in 0..2000 {
-            s += obj.eval(&v, &mut g);
-        }
-        let dt = t.elapsed().as_secs_f64();
-        println!("{:.1} ns per element eval ({s})", dt / 200000.0 * 1e9);
     }
 }

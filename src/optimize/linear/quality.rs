@@ -50,13 +50,14 @@ impl ElementQuality {
             let (blo, bhi) = b
                 .iter()
                 .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
-            let valid = (blo > lj.rounding_margin() && blo.is_finite()) || certify(&x).is_valid();
+            let tau = lj.rounding_margin();
+            let valid = (blo > tau && blo.is_finite()) || certify(&x).is_valid();
             if !valid {
                 // Invalid whatever the high-order stage does with the interior mid
                 // nodes (a coefficient only boundary nodes set is not positive): as bad
                 // as an inverted tet, so no operation creates one.
                 let free_mid = TET10_EDGES.map(|[i, j]| bnd.edge_mid(v[i], v[j]).is_none());
-                if !fixed_coefficients_positive(&x, free_mid) {
+                if !fixed_coefficients_positive(&b, tau, free_mid) {
                     return f64::NEG_INFINITY;
                 }
                 let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
