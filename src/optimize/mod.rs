@@ -18,7 +18,7 @@ mod dual;
 pub mod high_order;
 pub mod linear;
 #[cfg(test)]
-mod testmesh;
+pub(crate) mod testmesh;
 
 pub use boundary::Boundary;
 pub use high_order::{optimize_high_order, HighOrderParams, HighOrderStats};
