@@ -93,7 +93,7 @@ floor!(torus, 0.84, 0.62, 150_000);
 floor!(tube, 0.84, 0.62, 49_000);
 floor!(lv, 0.84, 0.62, 63_000);
 floor!(screw, 0.60, 0.68, 61_000);
-floor!(hinge, 0.43, 0.97, 525_000);
+floor!(hinge, 0.43, 0.85, 525_000);
 
 #[test]
 fn same_mesh_for_one_and_two_threads() {

@@ -3,7 +3,8 @@
 //! 1. [`linear`]: the straight-sided core is improved by flips (2-3, edge removal 3-2 /
 //!    4-4 / n-to-(2n-4)), contraction of edges with an interior end point, smoothing of
 //!    interior vertices and insertion of interior vertices on interior edges, worst
-//!    element first. Boundary vertices never move and boundary
+//!    element first; tets still very poor after that get a sampled search for better
+//!    positions of their interior vertices. Boundary vertices never move and boundary
 //!    faces never change; every operation keeps all tets positive (exact `orient3d`) and
 //!    every tet touching a curved boundary edge certified valid.
 //! 2. [`high_order`]: on the assembled P2 mesh, patches around the elements of lowest

@@ -193,6 +193,71 @@ pub(super) fn smooth_vertex(
     moved
 }
 
+/// Sampled search for a better position of interior vertex `v` when its worst tet is
+/// stuck in a poor local optimum of [`smooth_vertex`] (max-min quality is not smooth and
+/// ascent stops at a kink): shrinking rings of trial points around the best position so
+/// far, the best kept only if its star's minimum quality rose. Deterministic (a fixed
+/// low-discrepancy sequence). Returns true when it moved.
+pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> bool {
+    if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() {
+        return false;
+    }
+    s.star.clear();
+    s.star.extend_from_slice(&m.vt[v as usize]);
+    s.star
+        .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
+    let p0 = m.pts[v as usize];
+    let mut min_len = f64::INFINITY;
+    for &t in &s.star {
+        for &x in &m.tets[t as usize] {
+            if x != v {
+                min_len = min_len.min(dist(p0, m.pts[x as usize]));
+            }
+        }
+    }
+    let q0 = s
+        .star
+        .iter()
+        .map(|&t| m.q[t as usize])
+        .fold(f64::INFINITY, f64::min);
+    let (mut best, mut bq) = (p0, q0);
+    let mut scale = min_len;
+    const RINGS: usize = 10;
+    const PER_RING: usize = 96;
+    // Directions from a spherical Fibonacci lattice, radii cycling through (0, 1].
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    for _ in 0..RINGS {
+        let centre = best;
+        for i in 0..PER_RING {
+            let z = 1.0 - (2 * i + 1) as f64 / PER_RING as f64;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * i as f64;
+            let len = scale * [1.0, 0.66, 0.33][i % 3];
+            let p = [
+                centre[0] + len * r * phi.cos(),
+                centre[1] + len * r * phi.sin(),
+                centre[2] + len * z,
+            ];
+            let q = star_min(m, v, &s.star, p, bq, &mut s.qs);
+            if q > bq {
+                best = p;
+                bq = q;
+            }
+        }
+        scale *= 0.5;
+    }
+    if bq <= q0 + 1e-9 {
+        return false;
+    }
+    star_min(m, v, &s.star, best, f64::NEG_INFINITY, &mut s.qs);
+    m.pts[v as usize] = best;
+    m.touch_star(v);
+    for (&t, &q) in s.star.iter().zip(&s.qs) {
+        m.q[t as usize] = q;
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
