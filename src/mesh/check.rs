@@ -73,16 +73,22 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
     // per tet and outward face, the other tets holding the face. Far less memory than a
     // face hash map (the final check ran at 190 B/tet with one; this takes 20), and it runs
     // in parallel. The first error in tet order is reported.
-    let face_err = (0..m.tets.len()).into_par_iter().find_map_first(|ti| {
+    // One pass: each tet's count of one-tet faces, or the first defect (by tet order;
+    // its message is rebuilt afterwards, so the pass carries only indices).
+    let faces_of = |ti: usize| -> std::result::Result<usize, Error> {
         let t = &m.tets[ti];
+        let mut one = 0;
         for f in &OUT {
             let v = [t[f[0]], t[f[1]], t[f[2]]];
             let mut others = inc.with_face(m, v).filter(|&u| u != ti);
-            let Some(u) = others.next() else { continue };
+            let Some(u) = others.next() else {
+                one += 1;
+                continue;
+            };
             if others.next().is_some() {
                 let mut k = v;
                 k.sort_unstable();
-                return Some(bad(
+                return Err(bad(
                     vec![ti],
                     format!("face {k:?} is shared by more than two tets (tet {ti})"),
                 ));
@@ -91,7 +97,7 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
                 let (a, b) = (u.min(ti), u.max(ti));
                 let mut k = v;
                 k.sort_unstable();
-                return Some(bad(
+                return Err(bad(
                     vec![a, b],
                     format!(
                         "tets {a} and {b} overlap: they share face {k:?} with the same orientation"
@@ -99,24 +105,18 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
                 ));
             }
         }
-        None
-    });
-    if let Some(e) = face_err {
-        return Err(e);
-    }
-    // Faces of one tet; the count of two-tet faces follows (each is seen from both sides).
-    let one_tet: usize = (0..m.tets.len())
+        Ok(one)
+    };
+    let (one_tet, first_bad) = (0..m.tets.len())
         .into_par_iter()
-        .map(|ti| {
-            let t = &m.tets[ti];
-            OUT.iter()
-                .filter(|f| {
-                    let v = [t[f[0]], t[f[1]], t[f[2]]];
-                    inc.with_face(m, v).all(|u| u == ti)
-                })
-                .count()
+        .map(|ti| match faces_of(ti) {
+            Ok(n) => (n, usize::MAX),
+            Err(_) => (0, ti),
         })
-        .sum();
+        .reduce(|| (0, usize::MAX), |a, b| (a.0 + b.0, a.1.min(b.1)));
+    if first_bad != usize::MAX {
+        faces_of(first_bad)?;
+    }
     let interior = (4 * m.tets.len() - one_tet) / 2;
     if one_tet != m.boundary.len() {
         return Err(bad(
@@ -268,12 +268,16 @@ impl Incidence {
 
     /// The tets whose corners include the three of `v`.
     fn with_face<'a>(&'a self, m: &'a TetMesh, v: [u32; 3]) -> impl Iterator<Item = usize> + 'a {
-        self.around(v[0])
+        // Scan the shortest of the three lists.
+        let len = |x: u32| self.start[x as usize + 1] - self.start[x as usize];
+        let k = (0..3).min_by_key(|&k| len(v[k])).unwrap_or(0);
+        let (p, q) = (v[(k + 1) % 3], v[(k + 2) % 3]);
+        self.around(v[k])
             .iter()
             .map(|&u| u as usize)
             .filter(move |&u| {
                 let c = &m.tets[u][..4];
-                c.contains(&v[1]) && c.contains(&v[2])
+                c.contains(&p) && c.contains(&q)
             })
     }
 
@@ -281,6 +285,9 @@ impl Incidence {
     fn edge_mid(&self, m: &TetMesh, a: u32, b: u32) -> Option<u32> {
         self.around(a).iter().find_map(|&u| {
             let t = &m.tets[u as usize];
+            if !t[..4].contains(&b) {
+                return None;
+            }
             TET10_EDGES.iter().enumerate().find_map(|(e, [i, j])| {
                 ((t[*i] == a && t[*j] == b) || (t[*i] == b && t[*j] == a)).then_some(t[4 + e])
             })
