@@ -60,12 +60,13 @@ impl ElementQuality {
                 .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
             let tau = lj.rounding_margin();
             let valid = (blo > tau && blo.is_finite()) || certify(&x).is_valid();
+            // Edges the high-order stage may curve (not boundary edges).
+            let free_mid = || TET10_EDGES.map(|[i, j]| bnd.edge_mid(v[i], v[j]).is_none());
             if !valid {
                 // Invalid whatever the high-order stage does with the interior mid
                 // nodes (a coefficient only boundary nodes set is not positive): as bad
                 // as an inverted tet, so no operation creates one.
-                let free_mid = TET10_EDGES.map(|[i, j]| bnd.edge_mid(v[i], v[j]).is_none());
-                if !fixed_coefficients_positive(&b, tau, free_mid) {
+                if !fixed_coefficients_positive(&b, tau, free_mid()) {
                     return f64::NEG_INFINITY;
                 }
                 let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
@@ -80,10 +81,7 @@ impl ElementQuality {
             if nb == 4 {
                 // No interior vertex: the high-order stage can move few nodes of this
                 // tet, so its curved shape counts here (unrefined Bernstein ratio).
-                let free = TET10_EDGES
-                    .iter()
-                    .filter(|[i, j]| bnd.edge_mid(v[*i], v[*j]).is_none())
-                    .count();
+                let free = free_mid().iter().filter(|&&f| f).count();
                 let k = if free <= 1 { PINNED_CURVED_WEIGHT } else { 1.0 };
                 return (1.0 - s).min(k * ratio);
             }

@@ -88,6 +88,31 @@ fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64, qs: &mut Vec<f
     lo
 }
 
+/// Put the star of `v` into `s.star`, worst tet first (so that a failing trial position
+/// is rejected after few evaluations); returns the shortest edge at `v` and the star's
+/// minimum quality.
+fn load_star(m: &LinMesh, v: u32, s: &mut SmoothScratch) -> (f64, f64) {
+    s.star.clear();
+    s.star.extend_from_slice(&m.vt[v as usize]);
+    s.star
+        .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
+    let p = m.pts[v as usize];
+    let mut min_len = f64::INFINITY;
+    for &t in &s.star {
+        for &x in &m.tets[t as usize] {
+            if x != v {
+                min_len = min_len.min(dist(p, m.pts[x as usize]));
+            }
+        }
+    }
+    let qmin = s
+        .star
+        .iter()
+        .map(|&t| m.q[t as usize])
+        .fold(f64::INFINITY, f64::min);
+    (min_len, qmin)
+}
+
 /// Smooth interior vertex `v`; returns true when it moved.
 pub(super) fn smooth_vertex(
     m: &mut LinMesh,
@@ -98,28 +123,11 @@ pub(super) fn smooth_vertex(
     if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() || !m.dirty[v as usize] {
         return false;
     }
-    s.star.clear();
-    s.star.extend_from_slice(&m.vt[v as usize]);
-    // Worst first, so that a failing trial position is rejected after few evaluations.
-    s.star
-        .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
+    let (min_len, mut qmin) = load_star(m, v, s);
     let mut p = m.pts[v as usize];
     // Largest step: a third of the shortest edge at v.
-    let mut min_len = f64::INFINITY;
-    for &t in &s.star {
-        for &x in &m.tets[t as usize] {
-            if x != v {
-                min_len = min_len.min(dist(p, m.pts[x as usize]));
-            }
-        }
-    }
     let max_move = min_len / 3.0;
     let mut last_step = max_move;
-    let mut qmin = s
-        .star
-        .iter()
-        .map(|&t| m.q[t as usize])
-        .fold(f64::INFINITY, f64::min);
     let mut moved = false;
     for _ in 0..prm.max_iter {
         // Active pieces and their gradients.
@@ -202,24 +210,8 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
     if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() {
         return false;
     }
-    s.star.clear();
-    s.star.extend_from_slice(&m.vt[v as usize]);
-    s.star
-        .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
+    let (min_len, q0) = load_star(m, v, s);
     let p0 = m.pts[v as usize];
-    let mut min_len = f64::INFINITY;
-    for &t in &s.star {
-        for &x in &m.tets[t as usize] {
-            if x != v {
-                min_len = min_len.min(dist(p0, m.pts[x as usize]));
-            }
-        }
-    }
-    let q0 = s
-        .star
-        .iter()
-        .map(|&t| m.q[t as usize])
-        .fold(f64::INFINITY, f64::min);
     let (mut best, mut bq) = (p0, q0);
     let mut scale = min_len;
     const RINGS: usize = 10;
