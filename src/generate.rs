@@ -116,8 +116,9 @@ fn generate_inner(
 
     let bnd = Boundary::new(surface.nodes().len(), surface.triangles());
     // Front, linear stage, assembly, high-order stage, final check; when the check finds
-    // elements the optimizer could not untangle (in a conforming mesh), again from the
-    // front's next restart configuration (another search radius or size changes every
+    // elements the optimizer could not untangle (in a conforming mesh; without the
+    // optimizer, a curved tet the front took as a last resort), again from the front's
+    // next restart configuration (another search radius or size changes every
     // choice the greedy front makes, as for a front that cannot close). Bounded by
     // RESTARTS; the last attempt's result stands, whatever it is.
     let mut first = 0;
@@ -174,7 +175,7 @@ fn generate_inner(
         let (conf, bad) = pool.install(|| (check::check_conformity(&mesh), uncertified(&mesh)));
         times.certify += t.elapsed().as_secs_f64();
         let next = front.stats.restarts as usize + 1;
-        if opts.optimize && conf.is_ok() && !bad.is_empty() && next < RESTARTS.len() {
+        if conf.is_ok() && !bad.is_empty() && next < RESTARTS.len() {
             if progress(0.0, "front (restart: elements left invalid)") {
                 return Err(Error::Cancelled);
             }

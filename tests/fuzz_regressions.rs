@@ -47,6 +47,33 @@ fn fuzz_seeds() {
     assert!(replay(&root.join("fuzz/seeds")) >= 50);
 }
 
+/// The meshes the mesher refused when they were saved (tests/data/fuzz/mesh_icosphere:
+/// `InvalidMesh`, all without the optimizer, where no restart was made then) and the
+/// meshing seeds: each must now give a certified mesh or a clean MeshingFailed, never a
+/// refusal of its own mesh.
+#[test]
+fn saved_refusals_now_certify() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut n = 0;
+    for dir in [
+        "tests/data/fuzz/mesh_icosphere",
+        "fuzz/seeds/mesh_icosphere",
+    ] {
+        let mut files: Vec<_> = std::fs::read_dir(root.join(dir))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        files.sort();
+        for f in files {
+            let data = std::fs::read(&f).unwrap();
+            let r = std::panic::catch_unwind(|| fuzz::mesh_icosphere_strict(&data, true));
+            assert!(r.is_ok(), "{}: refused or failed", f.display());
+            n += 1;
+        }
+    }
+    assert!(n >= 4, "{n} inputs");
+}
+
 /// Each crash the fuzzers found, by name, with the clean error it must now give (release
 /// builds have no overflow checks, so the replay above alone would not see an overflow).
 #[test]
