@@ -179,11 +179,18 @@ fn damaged_icosphere(mode: u8, d: &[u8]) -> Arrays {
 /// guard fired) is accepted unless CURVETET_FUZZ_STRICT is set; a panic, a returned
 /// invalid mesh or another error kind is a failure.
 pub fn mesh_icosphere(data: &[u8]) {
-    mesh_icosphere_strict(data, std::env::var_os("CURVETET_FUZZ_STRICT").is_some());
+    // CURVETET_FUZZ_STRICT=1: every refusal fails; =optimized: only where the optimizer
+    // ran (without it nothing can untangle a curved tet the front had to take).
+    let strict = match std::env::var("CURVETET_FUZZ_STRICT").ok().as_deref() {
+        None => false,
+        Some("optimized") => data.first().is_some_and(|&m| m & 8 != 0),
+        Some(_) => true,
+    };
+    mesh_icosphere_strict(data, strict);
 }
 
 /// [`mesh_icosphere`], with `strict` deciding whether the mesher refusing its own mesh
-/// (`InvalidMesh`) fails the input (`CURVETET_FUZZ_STRICT=1` sets it for the fuzzer).
+/// (`InvalidMesh`) fails the input.
 pub fn mesh_icosphere_strict(data: &[u8], strict: bool) {
     let Some((&mode, d)) = data.split_first() else {
         return;
