@@ -122,7 +122,6 @@ fn generate_inner(
     // choice the greedy front makes, as for a front that cannot close). Bounded by
     // RESTARTS; the last attempt's result stands, whatever it is.
     let mut first = 0;
-    let mut pass = 0;
     let (front_stats, mesh, ostats, conf, bad) = loop {
         let t = Instant::now();
         let front = run_front(
@@ -165,8 +164,7 @@ fn generate_inner(
         }
         times.optimize += ostats.time_linear + ostats.time_high_order;
         // Tests only (see INJECT_FAULT_ENV): corrupt the mesh just before the final check.
-        let mesh = inject_fault(mesh, surface.nodes().len(), pass);
-        pass += 1;
+        let mesh = inject_fault(mesh, surface.nodes().len(), first == 0);
 
         if progress(1.0, "certify") {
             return Err(Error::Cancelled);
@@ -240,7 +238,7 @@ fn generate_inner(
 /// certified mesh). Tests only.
 pub const INJECT_FAULT_ENV: &str = "CURVETET_INJECT_INVALID_MESH";
 
-fn inject_fault(mut mesh: TetMesh, surface_nodes: usize, pass: usize) -> TetMesh {
+fn inject_fault(mut mesh: TetMesh, surface_nodes: usize, first_attempt: bool) -> TetMesh {
     let Ok(spec) = std::env::var(INJECT_FAULT_ENV) else {
         return mesh;
     };
@@ -257,7 +255,7 @@ fn inject_fault(mut mesh: TetMesh, surface_nodes: usize, pass: usize) -> TetMesh
             e.swap(5, 6);
             e.swap(7, 9);
         }
-        "jacobian" | "jacobian-once" if kind == "jacobian" || pass == 0 => {
+        "jacobian" | "jacobian-once" if kind == "jacobian" || first_attempt => {
             let e = mesh.tets[t];
             if let Some(k) = (0..6).find(|&k| e[4 + k] as usize >= surface_nodes) {
                 let (a, b) = (

@@ -176,8 +176,8 @@ fn damaged_icosphere(mode: u8, d: &[u8]) -> Arrays {
 /// `mesh_icosphere`: `generate` (1 thread) on a P2 icosphere (20 or 80 triangles) whose
 /// nodes the bytes move, with byte-chosen size mode, alpha and optimization. The result is
 /// a conforming, certified mesh of that surface or `MeshingFailed`; `InvalidMesh` (the bug
-/// guard fired) is accepted unless CURVETET_FUZZ_STRICT is set; a panic, a returned
-/// invalid mesh or another error kind is a failure.
+/// guard fired) is accepted unless CURVETET_FUZZ_STRICT asks otherwise (see below); a
+/// panic, a returned invalid mesh or another error kind is a failure.
 pub fn mesh_icosphere(data: &[u8]) {
     // CURVETET_FUZZ_STRICT=1: every refusal fails; =optimized: only where the optimizer
     // ran (without it nothing can untangle a curved tet the front had to take).
@@ -230,8 +230,8 @@ pub fn mesh_icosphere_strict(data: &[u8], strict: bool) {
         }
         Err(Error::MeshingFailed { .. }) => {}
         // The final check caught an invalid mesh and refused it: the guarantee holds, but
-        // the mesher made a bad element. CURVETET_FUZZ_STRICT=1 makes it a failure, to
-        // collect such inputs for the mesher.
+        // the mesher made a bad element. `strict` makes it a failure, to collect such
+        // inputs for the mesher.
         Err(Error::InvalidMesh { msg, .. }) => {
             if strict {
                 panic!("generate refused its own mesh: {msg}");

@@ -16,9 +16,7 @@ use crate::geom::distance::point_triangle_dist2;
 use crate::geom::predicates::{orient3d, point_in_closed_tet, segment_triangle_conflict};
 use crate::geom::vec3::*;
 
-/// Outward faces of a positive tet (v0, v1, v2, v3), by local vertex index; face k is
-/// opposite vertex k... except ordering: [base(opposite v3), opp v2, opp v0, opp v1].
-pub const TET_OUT_FACES: [[usize; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+pub use crate::geom::shape::TET_OUT_FACES;
 
 /// Why a candidate is not valid (for diagnostics; the front face involved, if any).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

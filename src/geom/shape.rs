@@ -10,6 +10,10 @@ use super::vec3::{cross, P3};
 /// Corner pairs of the three triangle edges, in mid-node order (nodes 3, 4, 5).
 pub const TRI6_EDGES: [[usize; 2]; 3] = [[0, 1], [1, 2], [2, 0]];
 
+/// Outward faces of a positive tet (v0, v1, v2, v3), by local vertex index, in the order
+/// [opposite v3 (the base), opposite v2, opposite v0, opposite v1].
+pub const TET_OUT_FACES: [[usize; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]];
+
 /// Corner pairs of the six tetrahedron edges, in mid-node order (nodes 4..9).
 pub const TET10_EDGES: [[usize; 2]; 6] = [[0, 1], [1, 2], [2, 0], [3, 0], [3, 2], [3, 1]];
 

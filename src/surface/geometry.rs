@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use super::describe;
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::predicates::collinear;
-use crate::geom::vec3::{cross, dot, norm, scale, sub};
+use crate::geom::vec3::{cross, dist, dot, mid, norm, scale, sub};
 use crate::geom::P3;
 
 /// Lattice order of the fold check.
@@ -138,9 +138,8 @@ pub fn check_mid_offsets(nodes: &[P3], tris: &[[u32; 6]]) -> Result<()> {
                 nodes[tri[(k + 1) % 3] as usize],
                 nodes[tri[3 + k] as usize],
             );
-            let len = norm(sub(b, a));
-            let c: P3 = std::array::from_fn(|d| 0.5 * (a[d] + b[d]));
-            let off = norm(sub(m, c));
+            let len = dist(a, b);
+            let off = dist(m, mid(a, b));
             (off > MAX_MID_OFFSET * len).then_some((t, k, off / len))
         })
     });

@@ -172,13 +172,7 @@ fn run_passes(
     let goal = 1.0 - prm.goal_skewness;
     for _ in 0..prm.max_passes {
         st.passes += 1;
-        order.clear();
-        for (t, &q) in m.q.iter().enumerate() {
-            if q < goal && m.alive(t as u32) {
-                order.push((q, t as u32, m.tets[t]));
-            }
-        }
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        worst_first(m, goal, order);
         let mut changed = 0;
         for &(_, t, tv) in order.iter() {
             if m.tets[t as usize] != tv || m.q[t as usize] >= goal {
@@ -191,7 +185,7 @@ fn run_passes(
             {
                 continue;
             }
-            if improve_tet(m, t, prm, sc, st) {
+            if improve_tet(m, t, prm.eps, sc, st) {
                 changed += 1;
             } else if m.tets[ti] == tv {
                 if failed.len() <= ti {
@@ -217,13 +211,7 @@ fn search_worst(
     order: &mut Vec<(f64, u32, [u32; 4])>,
 ) -> bool {
     let floor = 1.0 - prm.search_skewness;
-    order.clear();
-    for (t, &q) in m.q.iter().enumerate() {
-        if q < floor && m.alive(t as u32) {
-            order.push((q, t as u32, m.tets[t]));
-        }
-    }
-    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    worst_first(m, floor, order);
     let mut moved = false;
     for &(_, t, tv) in order.iter() {
         for &v in &tv {
@@ -239,15 +227,20 @@ fn search_worst(
     moved
 }
 
+/// The live tets of quality below `floor` with their corners, worst first (ties by
+/// index: deterministic), into `order`.
+fn worst_first(m: &LinMesh, floor: f64, order: &mut Vec<(f64, u32, [u32; 4])>) {
+    order.clear();
+    for (t, &q) in m.q.iter().enumerate() {
+        if q < floor && m.alive(t as u32) {
+            order.push((q, t as u32, m.tets[t]));
+        }
+    }
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+}
+
 /// One attempt at the bad tet `t`; true when the mesh changed.
-fn improve_tet(
-    m: &mut LinMesh,
-    t: u32,
-    prm: &LinearParams,
-    sc: &mut Scratch,
-    st: &mut LinearStats,
-) -> bool {
-    let eps = prm.eps;
+fn improve_tet(m: &mut LinMesh, t: u32, eps: f64, sc: &mut Scratch, st: &mut LinearStats) -> bool {
     let tv = m.tets[t as usize];
     for [i, j] in TET10_EDGES {
         if remove_edge(m, tv[i], tv[j], eps, &mut sc.flip) {
@@ -272,7 +265,6 @@ fn improve_tet(
     if moved && m.q[t as usize] > q0 {
         return true;
     }
-
     for [i, j] in TET10_EDGES {
         let (a, b) = (tv[i], tv[j]);
         if contract(m, a, b, eps, &mut sc.contract) || contract(m, b, a, eps, &mut sc.contract) {
