@@ -12,6 +12,7 @@
 //! Surface nodes are never variables.
 
 mod jacobian;
+mod lanes;
 mod lbfgs;
 mod objective;
 mod patch;
