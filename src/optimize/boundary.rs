@@ -17,7 +17,8 @@ pub struct Boundary {
 impl Boundary {
     /// The boundary of the closed P2 surface `tris` on the first `n_surf` points.
     pub fn new(n_surf: usize, tris: &[[u32; 6]]) -> Boundary {
-        let mut edge_mid = HashMap::with_capacity_and_hasher(tris.len() * 3 / 2, Default::default());
+        let mut edge_mid =
+            HashMap::with_capacity_and_hasher(tris.len() * 3 / 2, Default::default());
         for t in tris {
             for (k, [i, j]) in TRI6_EDGES.iter().enumerate() {
                 let (a, b) = (t[*i], t[*j]);

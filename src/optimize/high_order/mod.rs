@@ -23,6 +23,7 @@ use crate::geom::vec3::{dist, mid, P3};
 use crate::mesh::quality::tet_nodes;
 use crate::mesh::TetMesh;
 use crate::optimize::Boundary;
+use lanes::L;
 use lbfgs::Lbfgs;
 use objective::{nodes, Objective, PatchElem, FIXED};
 use patch::{colour, Marks, NodeElems, Patch};
@@ -117,10 +118,15 @@ pub struct HighOrderStats {
     pub element_evaluations: u64,
 }
 
-/// The optimizer's score of element `t` (see [`objective::score`]).
-#[inline]
-fn element_score(mesh: &TetMesh, t: usize, enough: f64) -> f64 {
-    objective::score(&tet_nodes(mesh, t), enough)
+/// The optimizer's scores (see [`objective::score_block`]) of the elements `ts` into `out`
+/// ([`L`] at a time, in parallel).
+fn element_scores(mesh: &TetMesh, ts: &[u32], enough: f64, out: &mut [f64]) {
+    out.par_chunks_mut(L)
+        .zip(ts.par_chunks(L))
+        .for_each(|(o, t)| {
+            let xs = std::array::from_fn(|l| tet_nodes(mesh, t[l.min(t.len() - 1)] as usize));
+            o.copy_from_slice(&objective::score_block(&xs, t.len(), enough)[..t.len()]);
+        });
 }
 
 /// Optimize the free nodes of `mesh` (every node at index >= `bnd.n_surf`). Runs on the
@@ -132,10 +138,9 @@ pub fn optimize_high_order(
 ) -> HighOrderStats {
     let mut st = HighOrderStats::default();
     let ne = mesh.tets.len();
-    let mut sj: Vec<f64> = (0..ne)
-        .into_par_iter()
-        .map(|t| element_score(mesh, t, prm.threshold))
-        .collect();
+    let all: Vec<u32> = (0..ne as u32).collect();
+    let mut sj = vec![0.0; ne];
+    element_scores(mesh, &all, prm.threshold, &mut sj);
     let sj_start = sj.clone();
     let census = |sj: &[f64]| {
         let min = sj.iter().copied().fold(f64::INFINITY, f64::min);
@@ -248,13 +253,13 @@ pub fn optimize_high_order(
         }
     }
     // Exact scores where a round stored a cheaper lower bound below the threshold.
-    let exact: Vec<(usize, f64)> = (0..ne)
-        .into_par_iter()
-        .filter(|&t| sj[t] < prm.threshold && sj[t] != sj_start[t])
-        .map(|t| (t, element_score(mesh, t, prm.threshold)))
+    let redo: Vec<u32> = (0..ne as u32)
+        .filter(|&t| sj[t as usize] < prm.threshold && sj[t as usize] != sj_start[t as usize])
         .collect();
-    for (t, v) in exact {
-        sj[t] = v;
+    let mut exact = vec![0.0; redo.len()];
+    element_scores(mesh, &redo, prm.threshold, &mut exact);
+    for (&t, v) in redo.iter().zip(exact) {
+        sj[t as usize] = v;
     }
     let (m1, i1, b1) = census(&sj);
     st.min_scaled_jacobian[1] = if ne == 0 { 1.0 } else { m1 };
@@ -328,20 +333,25 @@ fn evaluate(
     out.clear();
     let mut lo = f64::INFINITY;
     let mut sk = 0.0f64;
-    for el in elems {
-        let xe = nodes(el, v);
-        let s = objective::score(&xe, enough);
-        lo = lo.min(s);
-        if with_skew {
-            // An inverted corner tet counts as the worst skewness: the final check wants
-            // every corner tet positive, whatever the curved Jacobian says.
-            sk = if orient3d(xe[0], xe[1], xe[2], xe[3]) > 0 {
-                sk.max(skew(&xe))
-            } else {
-                f64::INFINITY
-            };
+    let mut xs = [[[0.0; 3]; 10]; L];
+    for chunk in elems.chunks(L) {
+        for l in 0..L {
+            xs[l] = nodes(&chunk[l.min(chunk.len() - 1)], v);
         }
-        out.push(s);
+        let sc = objective::score_block(&xs, chunk.len(), enough);
+        for (xe, &s) in xs.iter().zip(&sc).take(chunk.len()) {
+            lo = lo.min(s);
+            if with_skew {
+                // An inverted corner tet counts as the worst skewness: the final check
+                // wants every corner tet positive, whatever the curved Jacobian says.
+                sk = if orient3d(xe[0], xe[1], xe[2], xe[3]) > 0 {
+                    sk.max(skew(xe))
+                } else {
+                    f64::INFINITY
+                };
+            }
+            out.push(s);
+        }
     }
     (lo, sk)
 }

@@ -72,10 +72,24 @@ fn delta_of(x: &[P3; 10]) -> f64 {
 /// ratio (a lower bound of min J / max J, up to rounding) is returned without the
 /// subdivision that certifies the exact value: the optimizer only needs to know such an
 /// element is good enough.
-pub(super) fn score(x: &[P3; 10], enough: f64) -> f64 {
-    let (b, _) = bezier_forward(x);
+///
+/// Scores the first `n` of the elements `xs` (the rest are ignored), their Bernstein
+/// coefficients computed [`L`] at a time.
+pub(super) fn score_block(xs: &[[P3; 10]; L], n: usize, enough: f64) -> [f64; L] {
+    let bs = lanes::bezier_block(xs);
+    std::array::from_fn(|l| {
+        if l < n {
+            score_with(&xs[l], &bs[l], enough)
+        } else {
+            f64::NAN
+        }
+    })
+}
+
+/// [`score_block`]'s score of one element `x` given its Bernstein coefficients `b`.
+fn score_with(x: &[P3; 10], b: &[f64; 20], enough: f64) -> f64 {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for &v in &b {
+    for &v in b {
         lo = lo.min(v);
         hi = hi.max(v);
     }
@@ -86,7 +100,7 @@ pub(super) fn score(x: &[P3; 10], enough: f64) -> f64 {
     if s > 0.0 {
         return s;
     }
-    let m = min_measure(&b, delta_of(x));
+    let m = min_measure(b, delta_of(x));
     if m.is_nan() {
         f64::NEG_INFINITY
     } else {
