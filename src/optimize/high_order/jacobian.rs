@@ -12,11 +12,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::geom::bezier::{SLOT_WEIGHT, TRIPLE_SLOT};
-use crate::geom::vec3::{cross, dot, sub, P3};
+use crate::geom::vec3::{sub, P3};
+use std::ops::{Add, AddAssign, Mul, Sub};
 
 /// Column coefficient `c_d[j]` as (node, integer weight) terms, Gmsh node order (corners
 /// 0..3, mids of (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)); unused terms have weight 0.
-/// The reference for the written-out [`columns`] and [`backprop`] (checked by the tests).
+/// The reference for the written-out [`columns`] and [`UPD`] (checked by the tests).
 #[cfg_attr(not(test), allow(dead_code))]
 const COLS: [[[(usize, f64); 4]; 4]; 3] = [
     [
@@ -39,6 +40,40 @@ const COLS: [[[(usize, f64); 4]; 4]; 3] = [
     ],
 ];
 
+/// The arithmetic the coefficient and gradient code needs: `f64` for one element, and
+/// [`super::lanes`]' lane type for several at once, so that the formulas are written once
+/// and every lane rounds exactly as the one-element code.
+pub(super) trait Lane:
+    Copy + Default + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + AddAssign
+{
+    /// `v` in every lane.
+    fn splat(v: f64) -> Self;
+}
+
+impl Lane for f64 {
+    #[inline(always)]
+    fn splat(v: f64) -> f64 {
+        v
+    }
+}
+
+/// A vector of lanes.
+pub(super) type V3<T> = [T; 3];
+
+#[inline(always)]
+fn cross<T: Lane>(a: V3<T>, b: V3<T>) -> V3<T> {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+#[inline(always)]
+fn dot<T: Lane>(a: V3<T>, b: V3<T>) -> T {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 /// The Jacobian columns of one element (what [`backprop`] needs).
 pub(crate) struct JacTape {
     c: [[P3; 4]; 3],
@@ -50,14 +85,37 @@ pub(crate) struct JacTape {
 pub(crate) fn bezier_forward(x: &[P3; 10]) -> ([f64; 20], JacTape) {
     // Node positions relative to corner 0 (translation invariant, accurate far out).
     let y: [P3; 10] = std::array::from_fn(|i| sub(x[i], x[0]));
-    let c = columns(&y);
-    let mut x12 = [[[0.0; 3]; 4]; 4];
+    let (b, c) = coefficients(&y);
+    (b, JacTape { c })
+}
+
+/// Given `gb[s]` = ∂F/∂b_s, add ∂F/∂x_n to `gx[n]` for the ten nodes. The objective
+/// runs it on lanes ([`super::lanes`]); this one-element form is its reference in the
+/// tests.
+#[cfg_attr(not(test), allow(dead_code))]
+#[inline]
+pub(crate) fn backprop(tape: &JacTape, gb: &[f64; 20], gx: &mut [P3; 10]) {
+    let gs: [f64; 20] = std::array::from_fn(|s| gb[s] * SLOT_WEIGHT[s]);
+    let upd = node_gradient(&tape.c, &gs);
+    for (o, u) in gx.iter_mut().zip(upd.iter()) {
+        for k in 0..3 {
+            o[k] += u[k];
+        }
+    }
+}
+
+/// The weighted coefficients b_s of det J from node positions `y` relative to corner 0,
+/// and the columns `c`.
+#[inline(always)]
+pub(super) fn coefficients<T: Lane>(y: &[V3<T>; 10]) -> ([T; 20], [[V3<T>; 4]; 3]) {
+    let c = columns(y);
+    let mut x12 = [[[T::default(); 3]; 4]; 4];
     for j in 0..4 {
         for k in 0..4 {
             x12[j][k] = cross(c[1][j], c[2][k]);
         }
     }
-    let mut b = [0.0; 20];
+    let mut b = [T::default(); 20];
     for i in 0..4 {
         for j in 0..4 {
             for k in 0..4 {
@@ -65,36 +123,28 @@ pub(crate) fn bezier_forward(x: &[P3; 10]) -> ([f64; 20], JacTape) {
             }
         }
     }
-    for (v, w) in b.iter_mut().zip(SLOT_WEIGHT.iter()) {
-        *v *= w;
+    for s in 0..20 {
+        b[s] = b[s] * T::splat(SLOT_WEIGHT[s]);
     }
-    (b, JacTape { c })
+    (b, c)
 }
 
-/// Given `gb[s]` = ∂F/∂b_s, add ∂F/∂x_n to `gx[n]` for the ten nodes. The objective
-/// runs the lane-parallel copy in [`super::lanes`]; this one-element form is its
-/// reference in the tests.
-#[cfg_attr(not(test), allow(dead_code))]
-#[inline]
-pub(crate) fn backprop(tape: &JacTape, gb: &[f64; 20], gx: &mut [P3; 10]) {
-    let c = &tape.c;
-    let mut gs = [0.0; 20];
-    for s in 0..20 {
-        gs[s] = gb[s] * SLOT_WEIGHT[s];
-    }
+/// ∂F/∂x_n for the ten nodes from `gs[s]` = w_s ∂F/∂b_s and the columns `c`.
+#[inline(always)]
+pub(super) fn node_gradient<T: Lane>(c: &[[V3<T>; 4]; 3], gs: &[T; 20]) -> [V3<T>; 10] {
     // W_ijk = gs[slot(i, j, k)] is symmetric in (i, j, k). With U = Σ_k W_ijk c_2[k]:
     // ∂F/∂c_0[i] = Σ_j c_1[j] × U_ij, and cyclically for c_1 and c_2 (register-friendly
     // two-step contractions instead of 64 accumulations into memory).
-    let w = |i: usize, j: usize, k: usize| gs[TRIPLE_SLOT[16 * i + 4 * j + k] as usize];
-    let mut g = [[[0.0; 3]; 4]; 3];
+    let mut g = [[[T::default(); 3]; 4]; 3];
     for i in 0..4 {
-        let (mut a0, mut a1, mut a2) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+        let (mut a0, mut a1, mut a2) = ([T::default(); 3], [T::default(); 3], [T::default(); 3]);
         for j in 0..4 {
-            let (mut u0, mut u1, mut u2) = ([0.0; 3], [0.0; 3], [0.0; 3]);
+            let (mut u0, mut u1, mut u2) =
+                ([T::default(); 3], [T::default(); 3], [T::default(); 3]);
             for k in 0..4 {
                 // Slot (i, j, k) for c_0; (j, i, k) ~ (i, j, k) by symmetry, so the same
                 // weights serve the other two contractions with roles rotated.
-                let wt = w(i, j, k);
+                let wt = gs[TRIPLE_SLOT[16 * i + 4 * j + k] as usize];
                 for d in 0..3 {
                     u0[d] += wt * c[2][k][d];
                     u1[d] += wt * c[0][k][d];
@@ -114,67 +164,79 @@ pub(crate) fn backprop(tape: &JacTape, gb: &[f64; 20], gx: &mut [P3; 10]) {
         g[1][i] = a1;
         g[2][i] = a2;
     }
-    // ∂F/∂x_n = Σ_{d,j} COLS[d][j](n) g[d][j], written out.
-    let lin = |w: [f64; 12]| -> P3 {
-        let mut o = [0.0; 3];
-        for (t, wt) in w.iter().enumerate() {
-            let gv = g[t / 4][t % 4];
-            for k in 0..3 {
-                o[k] += wt * gv[k];
+    // ∂F/∂x_n = Σ_t UPD[n][t] g[t / 4][t % 4], one call per row so that each unrolls
+    // with its zero terms dropped at compile time.
+    let lin = |w: [f64; 12]| -> V3<T> {
+        let mut o = [T::default(); 3];
+        for (t, &wt) in w.iter().enumerate() {
+            if wt != 0.0 {
+                let gv = g[t / 4][t % 4];
+                for k in 0..3 {
+                    o[k] += T::splat(wt) * gv[k];
+                }
             }
         }
         o
     };
-    let upd = [
-        lin([-3., 1., 1., 1., -3., 1., 1., 1., -3., 1., 1., 1.]),
-        lin([-1., 3., -1., -1., 0., 0., 0., 0., 0., 0., 0., 0.]),
-        lin([0., 0., 0., 0., -1., -1., 3., -1., 0., 0., 0., 0.]),
-        lin([0., 0., 0., 0., 0., 0., 0., 0., -1., -1., -1., 3.]),
-        lin([4., -4., 0., 0., 0., -4., 0., 0., 0., -4., 0., 0.]),
-        lin([0., 0., 4., 0., 0., 4., 0., 0., 0., 0., 0., 0.]),
-        lin([0., 0., -4., 0., 4., 0., -4., 0., 0., 0., -4., 0.]),
-        lin([0., 0., 0., -4., 0., 0., 0., -4., 4., 0., 0., -4.]),
-        lin([0., 0., 0., 0., 0., 0., 0., 4., 0., 0., 4., 0.]),
-        lin([0., 0., 0., 4., 0., 0., 0., 0., 0., 4., 0., 0.]),
-    ];
-    for (o, u) in gx.iter_mut().zip(upd.iter()) {
-        for k in 0..3 {
-            o[k] += u[k];
-        }
-    }
+    [
+        lin(UPD[0]),
+        lin(UPD[1]),
+        lin(UPD[2]),
+        lin(UPD[3]),
+        lin(UPD[4]),
+        lin(UPD[5]),
+        lin(UPD[6]),
+        lin(UPD[7]),
+        lin(UPD[8]),
+        lin(UPD[9]),
+    ]
 }
 
+/// ∂F/∂x_n = Σ_t UPD[n][t] g[t / 4][t % 4] ([`COLS`] transposed; checked by the tests).
+const UPD: [[f64; 12]; 10] = [
+    [-3., 1., 1., 1., -3., 1., 1., 1., -3., 1., 1., 1.],
+    [-1., 3., -1., -1., 0., 0., 0., 0., 0., 0., 0., 0.],
+    [0., 0., 0., 0., -1., -1., 3., -1., 0., 0., 0., 0.],
+    [0., 0., 0., 0., 0., 0., 0., 0., -1., -1., -1., 3.],
+    [4., -4., 0., 0., 0., -4., 0., 0., 0., -4., 0., 0.],
+    [0., 0., 4., 0., 0., 4., 0., 0., 0., 0., 0., 0.],
+    [0., 0., -4., 0., 4., 0., -4., 0., 0., 0., -4., 0.],
+    [0., 0., 0., -4., 0., 0., 0., -4., 4., 0., 0., -4.],
+    [0., 0., 0., 0., 0., 0., 0., 4., 0., 0., 4., 0.],
+    [0., 0., 0., 4., 0., 0., 0., 0., 0., 4., 0., 0.],
+];
+
 /// The Jacobian columns `c[d][j]` from node positions relative to corner 0 ([`COLS`]
-/// written out; `y[0]` = 0).
-#[inline]
-fn columns(y: &[P3; 10]) -> [[P3; 4]; 3] {
-    let f = |t: [(usize, f64); 4]| -> P3 {
-        let mut v = [0.0; 3];
-        for (n, w) in t {
+/// written out without its zero terms; `y[0]` = 0).
+#[inline(always)]
+fn columns<T: Lane>(y: &[V3<T>; 10]) -> [[V3<T>; 4]; 3] {
+    let f = |t: &[(usize, f64)]| -> V3<T> {
+        let mut v = [T::default(); 3];
+        for &(n, w) in t {
             for k in 0..3 {
-                v[k] += w * y[n][k];
+                v[k] += T::splat(w) * y[n][k];
             }
         }
         v
     };
     [
         [
-            f([(4, 4.0), (1, -1.0), (0, 0.0), (0, 0.0)]),
-            f([(1, 3.0), (4, -4.0), (0, 0.0), (0, 0.0)]),
-            f([(5, 4.0), (6, -4.0), (1, -1.0), (0, 0.0)]),
-            f([(9, 4.0), (7, -4.0), (1, -1.0), (0, 0.0)]),
+            f(&[(4, 4.0), (1, -1.0)]),
+            f(&[(1, 3.0), (4, -4.0)]),
+            f(&[(5, 4.0), (6, -4.0), (1, -1.0)]),
+            f(&[(9, 4.0), (7, -4.0), (1, -1.0)]),
         ],
         [
-            f([(6, 4.0), (2, -1.0), (0, 0.0), (0, 0.0)]),
-            f([(5, 4.0), (4, -4.0), (2, -1.0), (0, 0.0)]),
-            f([(2, 3.0), (6, -4.0), (0, 0.0), (0, 0.0)]),
-            f([(8, 4.0), (7, -4.0), (2, -1.0), (0, 0.0)]),
+            f(&[(6, 4.0), (2, -1.0)]),
+            f(&[(5, 4.0), (4, -4.0), (2, -1.0)]),
+            f(&[(2, 3.0), (6, -4.0)]),
+            f(&[(8, 4.0), (7, -4.0), (2, -1.0)]),
         ],
         [
-            f([(7, 4.0), (3, -1.0), (0, 0.0), (0, 0.0)]),
-            f([(9, 4.0), (4, -4.0), (3, -1.0), (0, 0.0)]),
-            f([(8, 4.0), (6, -4.0), (3, -1.0), (0, 0.0)]),
-            f([(3, 3.0), (7, -4.0), (0, 0.0), (0, 0.0)]),
+            f(&[(7, 4.0), (3, -1.0)]),
+            f(&[(9, 4.0), (4, -4.0), (3, -1.0)]),
+            f(&[(8, 4.0), (6, -4.0), (3, -1.0)]),
+            f(&[(3, 3.0), (7, -4.0)]),
         ],
     ]
 }
@@ -224,6 +286,20 @@ mod tests {
                 for k in 0..3 {
                     assert!((v[k] - c[d][j][k]).abs() < 1e-14);
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn upd_is_cols_transposed() {
+        for n in 0..10 {
+            for t in 0..12 {
+                let w: f64 = COLS[t / 4][t % 4]
+                    .iter()
+                    .filter(|&&(m, _)| m == n)
+                    .map(|&(_, w)| w)
+                    .sum();
+                assert_eq!(UPD[n][t], w, "node {n}, column {t}");
             }
         }
     }

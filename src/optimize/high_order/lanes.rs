@@ -12,8 +12,9 @@
 // Index loops mirror the formulas (several arrays per index).
 #![allow(clippy::needless_range_loop)]
 
+use super::jacobian::{self, Lane, V3};
 use super::objective::ln_and_recip;
-use crate::geom::bezier::{SLOT_WEIGHT, TRIPLE_SLOT};
+use crate::geom::bezier::SLOT_WEIGHT;
 use crate::geom::vec3::P3;
 use std::ops::{Add, AddAssign, Mul, Sub};
 
@@ -24,11 +25,14 @@ pub(super) const L: usize = 4;
 #[derive(Clone, Copy, Debug, Default)]
 struct F([f64; L]);
 
-impl F {
+impl Lane for F {
     #[inline(always)]
     fn splat(v: f64) -> F {
         F([v; L])
     }
+}
+
+impl F {
     #[inline(always)]
     fn map(self, f: impl Fn(f64) -> f64) -> F {
         F(self.0.map(f))
@@ -69,22 +73,6 @@ impl AddAssign for F {
     fn add_assign(&mut self, o: F) {
         *self = *self + o;
     }
-}
-
-type V3 = [F; 3];
-
-#[inline(always)]
-fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-#[inline(always)]
-fn dot(a: V3, b: V3) -> F {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 /// The lane-wise [`ln_and_recip`] (a loop the compiler vectorizes: it is branch-free).
@@ -209,60 +197,7 @@ pub(super) fn eval_block_body(
     for s in 0..20 {
         gs[s] = ((df[s] - corr) * inv) * F::splat(SLOT_WEIGHT[s]);
     }
-    // Backprop (the contractions of `jacobian::backprop`).
-    let mut g = [[[F::default(); 3]; 4]; 3];
-    for i in 0..4 {
-        let (mut a0, mut a1, mut a2) = ([F::default(); 3], [F::default(); 3], [F::default(); 3]);
-        for j in 0..4 {
-            let (mut u0, mut u1, mut u2) =
-                ([F::default(); 3], [F::default(); 3], [F::default(); 3]);
-            for k in 0..4 {
-                let wt = gs[TRIPLE_SLOT[16 * i + 4 * j + k] as usize];
-                for d in 0..3 {
-                    u0[d] += wt * c[2][k][d];
-                    u1[d] += wt * c[0][k][d];
-                    u2[d] += wt * c[1][k][d];
-                }
-            }
-            let x0 = cross(c[1][j], u0);
-            let x1 = cross(c[2][j], u1);
-            let x2 = cross(c[0][j], u2);
-            for d in 0..3 {
-                a0[d] += x0[d];
-                a1[d] += x1[d];
-                a2[d] += x2[d];
-            }
-        }
-        g[0][i] = a0;
-        g[1][i] = a1;
-        g[2][i] = a2;
-    }
-    // Written out row by row so that the compiler unrolls each (a loop over the rows
-    // kept the zero tests at run time).
-    let lin = |w: [f64; 12]| -> V3 {
-        let mut o = [F::default(); 3];
-        for (t, &wt) in w.iter().enumerate() {
-            if wt != 0.0 {
-                let gv = g[t / 4][t % 4];
-                for k in 0..3 {
-                    o[k] += F::splat(wt) * gv[k];
-                }
-            }
-        }
-        o
-    };
-    let upd = [
-        lin(UPD[0]),
-        lin(UPD[1]),
-        lin(UPD[2]),
-        lin(UPD[3]),
-        lin(UPD[4]),
-        lin(UPD[5]),
-        lin(UPD[6]),
-        lin(UPD[7]),
-        lin(UPD[8]),
-        lin(UPD[9]),
-    ];
+    let upd = jacobian::node_gradient(&c, &gs);
     for l in 0..L {
         for n in 0..10 {
             for k in 0..3 {
@@ -272,11 +207,10 @@ pub(super) fn eval_block_body(
     }
 }
 
-/// The Bernstein coefficients of det J of each lane's element (`jacobian::bezier_forward`'s
-/// operations) and the Jacobian columns.
+/// The Bernstein coefficients of det J of each lane's element and the Jacobian columns
+/// ([`jacobian::coefficients`] on the nodes relative to corner 0, transposed to lanes).
 #[inline(always)]
-fn coefficients(x: &[[P3; 10]; L]) -> ([F; 20], [[V3; 4]; 3]) {
-    // Nodes relative to corner 0, transposed to lanes.
+fn coefficients(x: &[[P3; 10]; L]) -> ([F; 20], [[V3<F>; 4]; 3]) {
     let mut y = [[F::default(); 3]; 10];
     for n in 0..10 {
         for d in 0..3 {
@@ -285,26 +219,7 @@ fn coefficients(x: &[[P3; 10]; L]) -> ([F; 20], [[V3; 4]; 3]) {
             }
         }
     }
-    let c = columns(&y);
-    let mut x12 = [[[F::default(); 3]; 4]; 4];
-    for j in 0..4 {
-        for k in 0..4 {
-            x12[j][k] = cross(c[1][j], c[2][k]);
-        }
-    }
-    let mut b = [F::default(); 20];
-    for i in 0..4 {
-        for j in 0..4 {
-            for k in 0..4 {
-                let s = TRIPLE_SLOT[16 * i + 4 * j + k] as usize;
-                b[s] += dot(c[0][i], x12[j][k]);
-            }
-        }
-    }
-    for s in 0..20 {
-        b[s] = b[s] * F::splat(SLOT_WEIGHT[s]);
-    }
-    (b, c)
+    jacobian::coefficients(&y)
 }
 
 /// [`coefficients`] alone, for the objective's minimum measure.
@@ -331,52 +246,4 @@ unsafe fn bezier_block_avx2(x: &[[P3; 10]; L]) -> [[f64; 20]; L] {
 pub(super) fn bezier_block_body(x: &[[P3; 10]; L]) -> [[f64; 20]; L] {
     let (b, _) = coefficients(x);
     std::array::from_fn(|l| std::array::from_fn(|s| b[s].0[l]))
-}
-
-/// ∂F/∂x_n = Σ_t UPD[n][t] g[t / 4][t % 4] (the written-out `COLS` of `jacobian`).
-const UPD: [[f64; 12]; 10] = [
-    [-3., 1., 1., 1., -3., 1., 1., 1., -3., 1., 1., 1.],
-    [-1., 3., -1., -1., 0., 0., 0., 0., 0., 0., 0., 0.],
-    [0., 0., 0., 0., -1., -1., 3., -1., 0., 0., 0., 0.],
-    [0., 0., 0., 0., 0., 0., 0., 0., -1., -1., -1., 3.],
-    [4., -4., 0., 0., 0., -4., 0., 0., 0., -4., 0., 0.],
-    [0., 0., 4., 0., 0., 4., 0., 0., 0., 0., 0., 0.],
-    [0., 0., -4., 0., 4., 0., -4., 0., 0., 0., -4., 0.],
-    [0., 0., 0., -4., 0., 0., 0., -4., 4., 0., 0., -4.],
-    [0., 0., 0., 0., 0., 0., 0., 4., 0., 0., 4., 0.],
-    [0., 0., 0., 4., 0., 0., 0., 0., 0., 4., 0., 0.],
-];
-
-/// The Jacobian columns (`jacobian::columns`, same terms in the same order).
-#[inline(always)]
-fn columns(y: &[V3; 10]) -> [[V3; 4]; 3] {
-    let f = |t: &[(usize, f64)]| -> V3 {
-        let mut v = [F::default(); 3];
-        for &(n, w) in t {
-            for k in 0..3 {
-                v[k] += F::splat(w) * y[n][k];
-            }
-        }
-        v
-    };
-    [
-        [
-            f(&[(4, 4.0), (1, -1.0)]),
-            f(&[(1, 3.0), (4, -4.0)]),
-            f(&[(5, 4.0), (6, -4.0), (1, -1.0)]),
-            f(&[(9, 4.0), (7, -4.0), (1, -1.0)]),
-        ],
-        [
-            f(&[(6, 4.0), (2, -1.0)]),
-            f(&[(5, 4.0), (4, -4.0), (2, -1.0)]),
-            f(&[(2, 3.0), (6, -4.0)]),
-            f(&[(8, 4.0), (7, -4.0), (2, -1.0)]),
-        ],
-        [
-            f(&[(7, 4.0), (3, -1.0)]),
-            f(&[(9, 4.0), (4, -4.0), (3, -1.0)]),
-            f(&[(8, 4.0), (6, -4.0), (3, -1.0)]),
-            f(&[(3, 3.0), (7, -4.0)]),
-        ],
-    ]
 }
