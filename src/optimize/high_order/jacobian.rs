@@ -192,7 +192,7 @@ pub(super) fn node_gradient<T: Lane>(c: &[[V3<T>; 4]; 3], gs: &[T; 20]) -> [V3<T
     ]
 }
 
-/// ∂F/∂x_n = Σ_t UPD[n][t] g[t / 4][t % 4] ([`COLS`] transposed; checked by the tests).
+/// ∂F/∂x_n = Σ_t `UPD[n][t] g[t / 4][t % 4]` ([`COLS`] transposed; checked by the tests).
 const UPD: [[f64; 12]; 10] = [
     [-3., 1., 1., 1., -3., 1., 1., 1., -3., 1., 1., 1.],
     [-1., 3., -1., -1., 0., 0., 0., 0., 0., 0., 0., 0.],

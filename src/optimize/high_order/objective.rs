@@ -217,7 +217,7 @@ impl Objective<'_> {
     }
 
     /// Objective at `v`, gradient into `g`. Elements go through [`lanes::eval_block`]
-    /// [`L`] at a time (bit-identical to one at a time, see [`tests`]).
+    /// [`L`] at a time (bit-identical to one at a time; tested).
     pub fn eval(&self, v: &[f64], g: &mut [f64]) -> f64 {
         g.iter_mut().for_each(|x| *x = 0.0);
         let eps = self.eps;
