@@ -1,10 +1,11 @@
 //! The objective's per-element work ([`super::objective`]) for [`L`] elements at once,
-//! one element per SIMD lane: the Bernstein coefficients of det J, the barrier terms and
-//! the reverse-mode gradient, written as lane-wise arithmetic that the compiler turns
-//! into vector instructions (AVX2 where the CPU has it, chosen at run time; SSE2
-//! otherwise). Every lane performs exactly the operations of the one-element code in the
-//! same order (no fused multiply-add), so results are bit-identical to it on any CPU
-//! (tested): only the speed depends on the machine.
+//! one element per SIMD lane: the Bernstein coefficients of det J and the reverse-mode
+//! gradient (the formulas of [`jacobian`], generic over the lane type) and the barrier
+//! terms, as lane-wise arithmetic that the compiler turns into vector instructions (AVX2
+//! where the CPU has it, chosen at run time; SSE2 otherwise). Every lane performs exactly
+//! the operations of the one-element code in the same order (no fused multiply-add), so
+//! results are bit-identical to it on any CPU (tested): only the speed depends on the
+//! machine.
 //!
 //! Hand-written rather than taken from a SIMD crate: the ones on stable Rust pick their
 //! instruction set at compile time, while a portable binary has to choose at run time.
