@@ -14,7 +14,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::jacobian::{self, Lane, V3};
-use super::objective::ln_and_recip;
+use super::objective::{ln_and_recip, norm_of_mean};
 use crate::geom::bezier::SLOT_WEIGHT;
 use crate::geom::vec3::P3;
 use std::ops::{Add, AddAssign, Mul, Sub};
@@ -157,10 +157,10 @@ pub(super) fn eval_block_body(
         sum += b[s];
     }
     let mean = sum.map(|v| v / 20.0);
-    let dl = F(delta);
-    let r = (mean * mean + dl * dl).map(f64::sqrt);
-    let nrm = (mean + r).map(|v| 0.5 * v);
-    let dn = mean.zip(r, |mu, r| 0.5 * (1.0 + if r > 0.0 { mu / r } else { 0.0 }));
+    let (mut nrm, mut dn) = (F::default(), F::default());
+    for l in 0..L {
+        (nrm.0[l], dn.0[l]) = norm_of_mean(mean.0[l], delta[l]);
+    }
     let inv = nrm.map(|v| 1.0 / v);
     let mut m = [F::default(); 20];
     let mut lo = F::splat(f64::INFINITY);

@@ -335,9 +335,7 @@ fn evaluate(
     let mut sk = 0.0f64;
     let mut xs = [[[0.0; 3]; 10]; L];
     for chunk in elems.chunks(L) {
-        for l in 0..L {
-            xs[l] = nodes(&chunk[l.min(chunk.len() - 1)], v);
-        }
+        objective::gather(chunk, v, &mut xs);
         let sc = objective::score_block(&xs, chunk.len(), enough);
         for (xe, &s) in xs.iter().zip(&sc).take(chunk.len()) {
             lo = lo.min(s);

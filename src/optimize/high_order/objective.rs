@@ -138,8 +138,8 @@ pub(super) fn ln_and_recip(x: f64) -> (f64, f64) {
 }
 
 /// The normalization N(μ) and its derivative.
-#[inline]
-fn norm_of_mean(mu: f64, delta: f64) -> (f64, f64) {
+#[inline(always)]
+pub(super) fn norm_of_mean(mu: f64, delta: f64) -> (f64, f64) {
     let r = (mu * mu + delta * delta).sqrt();
     (
         0.5 * (mu + r),
@@ -180,6 +180,15 @@ pub(super) fn nodes(e: &PatchElem, v: &[f64]) -> [P3; 10] {
     x
 }
 
+/// The nodes of the elements of `chunk` (at most [`L`]) for variables `v` into `xs`; a
+/// short chunk repeats its last element in the spare lanes.
+#[inline]
+pub(super) fn gather(chunk: &[PatchElem], v: &[f64], xs: &mut [[P3; 10]; L]) {
+    for (l, x) in xs.iter_mut().enumerate() {
+        *x = nodes(&chunk[l.min(chunk.len() - 1)], v);
+    }
+}
+
 /// Smallest measure of `b` (min b / N(mean b)).
 #[inline]
 pub(super) fn min_measure(b: &[f64; 20], delta: f64) -> f64 {
@@ -199,9 +208,7 @@ impl Objective<'_> {
         let mut ratio = f64::INFINITY;
         let mut xs = [[[0.0; 3]; 10]; L];
         for chunk in self.elems.chunks(L) {
-            for l in 0..L {
-                xs[l] = nodes(&chunk[l.min(chunk.len() - 1)], v);
-            }
+            gather(chunk, v, &mut xs);
             let bs = lanes::bezier_block(&xs);
             for (e, b) in chunk.iter().zip(&bs) {
                 lo = lo.min(min_measure(b, e.delta));
@@ -229,11 +236,9 @@ impl Objective<'_> {
         let mut delta = [0.0; L];
         let mut out = lanes::BlockOut::default();
         for chunk in self.elems.chunks(L) {
-            // A short last chunk repeats its last element in the spare lanes.
-            for l in 0..L {
-                let e = &chunk[l.min(chunk.len() - 1)];
-                xs[l] = nodes(e, v);
-                delta[l] = e.delta;
+            gather(chunk, v, &mut xs);
+            for (l, d) in delta.iter_mut().enumerate() {
+                *d = chunk[l.min(chunk.len() - 1)].delta;
             }
             lanes::eval_block(&xs, delta, eps, lden, &mut out);
             for (l, e) in chunk.iter().enumerate() {

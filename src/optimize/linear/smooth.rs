@@ -191,11 +191,7 @@ pub(super) fn smooth_vertex(
             break;
         }
         moved = true;
-        m.pts[v as usize] = p;
-        m.touch_star(v);
-        for (&t, &q) in s.star.iter().zip(&s.qs) {
-            m.q[t as usize] = q;
-        }
+        place(m, v, p, s);
     }
     m.dirty[v as usize] = false;
     moved
@@ -242,12 +238,17 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
         return false;
     }
     star_min(m, v, &s.star, best, f64::NEG_INFINITY, &mut s.qs);
-    m.pts[v as usize] = best;
+    place(m, v, best, s);
+    true
+}
+
+/// Move `v` to `p`, with `s.qs` holding the qualities of its star (`s.star`) there.
+fn place(m: &mut LinMesh, v: u32, p: P3, s: &SmoothScratch) {
+    m.pts[v as usize] = p;
     m.touch_star(v);
     for (&t, &q) in s.star.iter().zip(&s.qs) {
         m.q[t as usize] = q;
     }
-    true
 }
 
 #[cfg(test)]
