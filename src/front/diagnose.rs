@@ -8,7 +8,6 @@ use super::Mesher;
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::*;
-use kiddo::SquaredEuclidean;
 use std::fmt::Write;
 
 impl Mesher<'_> {
@@ -32,15 +31,11 @@ impl Mesher<'_> {
             c,
             self.size_at(c)
         );
-        let mut ids: Vec<u32> = self
-            .vtree
-            .query(&a)
-            .within::<SquaredEuclidean<f64>>(r * r)
-            .unsorted()
-            .execute()
-            .iter()
-            .map(|x| x.item)
-            .collect();
+        let mut found = Vec::new();
+        let in_tree = &self.in_tree;
+        self.vgrid
+            .within(a, r, &self.pts, |v| in_tree[v as usize], &mut found);
+        let mut ids: Vec<u32> = found.iter().map(|x| x.0).collect();
         for k in 0..3 {
             if let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) {
                 let gv = self.faces[g as usize].v;

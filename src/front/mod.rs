@@ -23,8 +23,7 @@ use crate::geom::shape::{tri6_normal, TET10_EDGES};
 use crate::geom::vec3::*;
 use crate::options::Options;
 use crate::{Error, Result};
-use grid::{Aabb, FaceGrid};
-use kiddo::{MutableKdTree, SquaredEuclidean};
+use grid::{Aabb, FaceGrid, PointGrid};
 use rustc_hash::FxHashMap as HashMap;
 use size::{regular_height, SizeField};
 use std::cmp::Reverse;
@@ -143,7 +142,7 @@ pub(crate) struct Mesher<'a> {
     /// Directed edge (a, b) of a live front face -> that face.
     edges: HashMap<(u32, u32), u32>,
     grid: FaceGrid,
-    vtree: MutableKdTree<f64, 3>,
+    vgrid: PointGrid,
     tets: Vec<[u32; 4]>,
     tet_alive: Vec<bool>,
     size: &'a SizeField,
@@ -158,6 +157,7 @@ pub(crate) struct Mesher<'a> {
     near_ids: Vec<u32>,
     near: Vec<FaceRef>,
     cands: Vec<Cand>,
+    found: Vec<(u32, f64)>,
     volume_done: f64,
 }
 
@@ -207,7 +207,11 @@ impl<'a> Mesher<'a> {
                 cell,
                 (16 * surf_tris.len()).max(1 << 16),
             ),
-            vtree: MutableKdTree::default(),
+            vgrid: PointGrid::new(
+                Aabb::of(surf_nodes),
+                cell,
+                (16 * surf_tris.len()).max(1 << 16),
+            ),
             tets: Vec::new(),
             tet_alive: Vec::new(),
             size,
@@ -219,6 +223,7 @@ impl<'a> Mesher<'a> {
             near_ids: Vec::new(),
             near: Vec::new(),
             cands: Vec::new(),
+            found: Vec::new(),
             volume_done: 0.0,
         };
         for (i, t) in surf_tris.iter().enumerate() {
@@ -262,7 +267,7 @@ impl<'a> Mesher<'a> {
             self.vdeg[xi] += 1;
             if !self.in_tree[xi] {
                 self.in_tree[xi] = true;
-                let _ = self.vtree.add(&self.pts[xi], x);
+                self.vgrid.insert(x, self.pts[xi]);
             }
         }
         self.enqueue(id);
@@ -340,14 +345,6 @@ impl<'a> Mesher<'a> {
             self.vdeg[xi] -= 1;
             if self.vdeg[xi] == 0 && self.in_tree[xi] {
                 self.in_tree[xi] = false;
-                // kiddo 6.3 sometimes fails to remove the item (seen on the 1M-tet torus,
-                // never on the data surfaces or at 100k): radius queries then still return
-                // the retired vertex. Its tets fail validity, but it also counts in the
-                // new-point spacing check. Dropping such items (rebuilding the tree from
-                // the live vertices) made the 1M torus worse: 948k tets instead of 870k,
-                // 2.4x the relaxed steps, 7x the cavities. Left as is, deterministic; see
-                // the 2026-11-23 closing note.
-                self.vtree.remove(&self.pts[xi], x);
             }
         }
     }
@@ -527,21 +524,18 @@ impl<'a> Mesher<'a> {
             _ => (3.0 * self.alpha * h, 0.25 * l_field),
         };
         // Candidate existing vertices.
-        let found = self
-            .vtree
-            .query(&a)
-            .within::<SquaredEuclidean<f64>>(radius * radius)
-            .unsorted()
-            .execute();
+        let mut found = std::mem::take(&mut self.found);
+        let in_tree = &self.in_tree;
+        self.vgrid
+            .within(a, radius, &self.pts, |v| in_tree[v as usize], &mut found);
         self.cands.clear();
         let mut nearest_existing = f64::INFINITY;
-        for r in &found {
-            let id = r.item;
+        for &(id, d2) in &found {
             if f.v.contains(&id) {
                 continue;
             }
             let p = self.pts[id as usize];
-            nearest_existing = nearest_existing.min(r.distance.sqrt());
+            nearest_existing = nearest_existing.min(d2.sqrt());
             if orient3d(fp[0], fp[1], fp[2], p) <= 0 {
                 continue;
             }
@@ -549,9 +543,10 @@ impl<'a> Mesher<'a> {
                 id,
                 p,
                 q: 0.0,
-                dist_a: r.distance.sqrt(),
+                dist_a: d2.sqrt(),
             });
         }
+        self.found = found;
         // The vertices across the face's edges (the neighbours' apexes) are always
         // candidates, however far: they are how a wedge closes, and with mixed sizes a
         // large neighbour's apex can lie outside the search radius.
@@ -798,17 +793,17 @@ impl<'a> Mesher<'a> {
         self.near_ids = ids;
     }
 
-    fn nearest_front_vertex(&self, p: P3, r: f64) -> f64 {
-        let found = self
-            .vtree
-            .query(&p)
-            .within::<SquaredEuclidean<f64>>(r * r)
-            .unsorted()
-            .execute();
-        found
+    fn nearest_front_vertex(&mut self, p: P3, r: f64) -> f64 {
+        let mut found = std::mem::take(&mut self.found);
+        let in_tree = &self.in_tree;
+        self.vgrid
+            .within(p, r, &self.pts, |v| in_tree[v as usize], &mut found);
+        let d = found
             .iter()
-            .map(|x| x.distance.sqrt())
-            .fold(f64::INFINITY, f64::min)
+            .map(|x| x.1.sqrt())
+            .fold(f64::INFINITY, f64::min);
+        self.found = found;
+        d
     }
 
     fn insert_tet(&mut self, t: [u32; 4], base: u32) {
