@@ -165,9 +165,10 @@ impl FaceGrid {
 ///
 /// Hand-written on [`FaceGrid`] rather than a k-d tree crate: the front adds and retires
 /// vertices at every step, and kiddo 6.3's `MutableKdTree` neither rebalances on removal
-/// (its queries grew from 1.3 to 3.2 µs per tet between the 100k- and 1M-tet torus) nor
-/// always removes (retired vertices were still returned at 1M). Here removal is the
-/// caller's liveness test, and dead ids are swept out of the cells a query visits.
+/// (kiddo issue #76) nor always removes (retired vertices were still returned on the
+/// 1M-tet torus). Here removal is the caller's liveness test, and dead ids are swept out
+/// of the cells a query visits. Measured against the tree: the 100k-tet torus's front
+/// 2.27 -> 1.96 s, the 1M one's 24.7 -> 23.5 s.
 pub struct PointGrid {
     grid: FaceGrid,
     ids: Vec<u32>,
