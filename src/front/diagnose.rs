@@ -32,9 +32,7 @@ impl Mesher<'_> {
             self.size_at(c)
         );
         let mut found = Vec::new();
-        let in_tree = &self.in_tree;
-        self.vgrid
-            .within(a, r, &self.pts, |v| in_tree[v as usize], &mut found);
+        self.front_vertices_within(a, r, &mut found);
         let mut ids: Vec<u32> = found.iter().map(|x| x.0).collect();
         for k in 0..3 {
             if let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) {

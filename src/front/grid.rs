@@ -7,7 +7,7 @@
 //! The grid covers the surface's bounding box; the cell count is capped so memory stays
 //! proportional to the input (cells grow when the cap is reached).
 
-use crate::geom::vec3::P3;
+use crate::geom::vec3::{dist2, P3};
 
 /// Axis-aligned box.
 #[derive(Clone, Copy, Debug)]
@@ -209,9 +209,7 @@ impl PointGrid {
         self.grid.query(&b, alive, &mut ids);
         let r2 = r * r;
         for &i in &ids {
-            let p = pts[i as usize];
-            let d = [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-            let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let d2 = dist2(pts[i as usize], q);
             if d2 <= r2 {
                 out.push((i, d2));
             }

@@ -130,8 +130,9 @@ pub(crate) struct Mesher<'a> {
     surf_tris: &'a [[u32; 6]],
     n_surf: usize,
     pts: Vec<P3>,
+    /// Live front faces at each vertex: the vertex is on the front (a candidate, in
+    /// `vgrid`) while this is positive.
     vdeg: Vec<u32>,
-    in_tree: Vec<bool>,
     faces: Vec<Face>,
     /// `faces[i].alive`, compact (the grid reads it for every listed face).
     face_alive: Vec<bool>,
@@ -187,6 +188,7 @@ impl<'a> Mesher<'a> {
         // floors, 2-3 edge lengths): twice the mean edge was 15-20% faster on the front
         // than one mean edge (100k-tet torus; fewer cells visited, fewer duplicates).
         let cell = 2.0 * mean_edge.max(edge_len_max / 8.0);
+        let (bounds, max_cells) = (Aabb::of(surf_nodes), (16 * surf_tris.len()).max(1 << 16));
         let mut m = Mesher {
             opts,
             surf_nodes,
@@ -194,7 +196,6 @@ impl<'a> Mesher<'a> {
             n_surf,
             pts: surf_nodes.to_vec(),
             vdeg: vec![0; n_surf],
-            in_tree: vec![false; n_surf],
             faces: Vec::with_capacity(surf_tris.len() * 4),
             face_alive: Vec::with_capacity(surf_tris.len() * 4),
             face_map: HashMap::with_capacity_and_hasher(surf_tris.len() * 2, Default::default()),
@@ -202,16 +203,8 @@ impl<'a> Mesher<'a> {
             bedge_mid,
             heap: BinaryHeap::new(),
             edges: HashMap::with_capacity_and_hasher(surf_tris.len() * 6, Default::default()),
-            grid: FaceGrid::new(
-                Aabb::of(surf_nodes),
-                cell,
-                (16 * surf_tris.len()).max(1 << 16),
-            ),
-            vgrid: PointGrid::new(
-                Aabb::of(surf_nodes),
-                cell,
-                (16 * surf_tris.len()).max(1 << 16),
-            ),
+            grid: FaceGrid::new(bounds, cell, max_cells),
+            vgrid: PointGrid::new(bounds, cell, max_cells),
             tets: Vec::new(),
             tet_alive: Vec::new(),
             size,
@@ -265,8 +258,7 @@ impl<'a> Mesher<'a> {
         for &x in &v {
             let xi = x as usize;
             self.vdeg[xi] += 1;
-            if !self.in_tree[xi] {
-                self.in_tree[xi] = true;
+            if self.vdeg[xi] == 1 {
                 self.vgrid.insert(x, self.pts[xi]);
             }
         }
@@ -340,12 +332,9 @@ impl<'a> Mesher<'a> {
             }
         }
         self.face_map.remove(&key3(v));
+        // A vertex whose count drops to 0 leaves the front; `vgrid` skips it from then on.
         for &x in &v {
-            let xi = x as usize;
-            self.vdeg[xi] -= 1;
-            if self.vdeg[xi] == 0 && self.in_tree[xi] {
-                self.in_tree[xi] = false;
-            }
+            self.vdeg[x as usize] -= 1;
         }
     }
 
@@ -353,7 +342,6 @@ impl<'a> Mesher<'a> {
         let id = self.pts.len() as u32;
         self.pts.push(p);
         self.vdeg.push(0);
-        self.in_tree.push(false);
         id
     }
 
@@ -525,9 +513,7 @@ impl<'a> Mesher<'a> {
         };
         // Candidate existing vertices.
         let mut found = std::mem::take(&mut self.found);
-        let in_tree = &self.in_tree;
-        self.vgrid
-            .within(a, radius, &self.pts, |v| in_tree[v as usize], &mut found);
+        self.front_vertices_within(a, radius, &mut found);
         self.cands.clear();
         let mut nearest_existing = f64::INFINITY;
         for &(id, d2) in &found {
@@ -793,11 +779,16 @@ impl<'a> Mesher<'a> {
         self.near_ids = ids;
     }
 
+    /// The front vertices within `r` of `q`, with their squared distances, into `out`.
+    fn front_vertices_within(&mut self, q: P3, r: f64, out: &mut Vec<(u32, f64)>) {
+        let vdeg = &self.vdeg;
+        self.vgrid
+            .within(q, r, &self.pts, |v| vdeg[v as usize] > 0, out);
+    }
+
     fn nearest_front_vertex(&mut self, p: P3, r: f64) -> f64 {
         let mut found = std::mem::take(&mut self.found);
-        let in_tree = &self.in_tree;
-        self.vgrid
-            .within(p, r, &self.pts, |v| in_tree[v as usize], &mut found);
+        self.front_vertices_within(p, r, &mut found);
         let d = found
             .iter()
             .map(|x| x.1.sqrt())
