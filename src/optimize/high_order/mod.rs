@@ -66,12 +66,22 @@ pub struct HighOrderParams {
     pub rescue_below: f64,
     /// Barrier updates per patch.
     pub barrier_updates: usize,
+    /// [`HighOrderParams::barrier_updates`] when the worst element is at least
+    /// [`HighOrderParams::reach_below`] at the start: where every element is already
+    /// fair, two updates suffice (with [`HighOrderParams::direct_stop_slack`], 14-21% less
+    /// work than three on the sphere, torus, tube and lv, the same certified minimum to
+    /// three decimals).
+    pub direct_barrier_updates: usize,
     /// L-BFGS iterations per barrier.
     pub iterations: usize,
     /// An L-BFGS run stops once every element of its patch is this far above the
     /// threshold (so that the neighbours' later patches do not push them straight back
     /// below it).
     pub stop_slack: f64,
+    /// [`HighOrderParams::stop_slack`] when the worst element is at least
+    /// [`HighOrderParams::reach_below`] at the start (see
+    /// [`HighOrderParams::direct_barrier_updates`]).
+    pub direct_stop_slack: f64,
 }
 
 impl Default for HighOrderParams {
@@ -91,6 +101,8 @@ impl Default for HighOrderParams {
             barrier_updates: 3,
             iterations: 6,
             stop_slack: 0.03,
+            direct_barrier_updates: 2,
+            direct_stop_slack: 0.01,
         }
     }
 }
@@ -165,6 +177,16 @@ pub fn optimize_high_order(
                 prm.threshold
             } else {
                 prm.vertices_below
+            },
+            stop_slack: if direct {
+                prm.direct_stop_slack
+            } else {
+                prm.stop_slack
+            },
+            barrier_updates: if direct {
+                prm.direct_barrier_updates
+            } else {
+                prm.barrier_updates
             },
             threshold: if direct {
                 prm.threshold

@@ -143,7 +143,8 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
             }
             let nv = tv.map(|x| if x == r { k } else { x });
             let c = nv.map(|x| if x == k { p } else { m.pts[x as usize] });
-            worst = worst.min(m.quality_at(nv, &c));
+            let floor = best.map_or(old + eps, |b| b.0.max(old + eps));
+            worst = worst.min(m.quality_above(nv, &c, floor));
             if worst <= old + eps || best.is_some_and(|b| worst <= b.0) {
                 break;
             }

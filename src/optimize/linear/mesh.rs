@@ -79,6 +79,12 @@ impl<'a> LinMesh<'a> {
         self.eq.eval(self.bnd, &self.pts, v, c)
     }
 
+    /// [`LinMesh::quality_at`] when it is above `floor`, else some value ≤ `floor`.
+    #[inline]
+    pub fn quality_above(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
+        self.eq.eval_above(self.bnd, &self.pts, v, c, floor)
+    }
+
     /// True for a live tet slot.
     #[inline]
     pub fn alive(&self, t: u32) -> bool {

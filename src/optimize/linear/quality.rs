@@ -37,6 +37,21 @@ impl ElementQuality {
     /// boundary mid nodes).
     #[inline]
     pub fn eval(&self, bnd: &Boundary, pts: &[P3], v: [u32; 4], c: &[P3; 4]) -> f64 {
+        self.eval_above(bnd, pts, v, c, f64::NEG_INFINITY)
+    }
+
+    /// [`ElementQuality::eval`] when it is above `floor`; otherwise some value ≤ `floor`
+    /// (the corner skewness alone already decides it: every score is at most 1 − skewness,
+    /// so the curved part, the costly one, is skipped).
+    #[inline]
+    pub fn eval_above(
+        &self,
+        bnd: &Boundary,
+        pts: &[P3],
+        v: [u32; 4],
+        c: &[P3; 4],
+        floor: f64,
+    ) -> f64 {
         if orient3d(c[0], c[1], c[2], c[3]) <= 0 {
             return f64::NEG_INFINITY;
         }
@@ -44,6 +59,9 @@ impl ElementQuality {
         let s = skewness_from_extremes(lo, hi);
         if !s.is_finite() {
             return f64::NEG_INFINITY;
+        }
+        if 1.0 - s <= floor {
+            return 1.0 - s;
         }
         let nb = v.iter().filter(|&&x| bnd.is_fixed(x)).count();
         if nb >= 2 {
@@ -135,6 +153,39 @@ pub(super) fn skew_pieces(c: &[P3; 4], k: usize) -> [D3; 12] {
 mod tests {
     use super::*;
     use crate::geom::quality::{dihedral_angles, equiangular_skewness};
+
+    #[test]
+    fn eval_above_agrees_with_eval_above_the_floor() {
+        use rand::{Rng, SeedableRng};
+        // A cube with a bulged (curved) boundary, corners moved at random: tets with
+        // curved boundary faces, inverted and poor ones, against floors across [−1, 1].
+        let c = crate::optimize::testmesh::cube(3, 0.08);
+        let bnd = c.boundary();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        let (mut curved, mut cut) = (0, 0);
+        for _ in 0..20 {
+            for t in &c.tets {
+                let x: [P3; 4] = std::array::from_fn(|i| {
+                    let p = c.pts[t[i] as usize];
+                    std::array::from_fn(|d| p[d] + rng.random_range(-0.12..0.12))
+                });
+                let q = ElementQuality.eval(&bnd, &c.pts, *t, &x);
+                if t.iter().filter(|&&v| bnd.is_fixed(v)).count() >= 2 {
+                    curved += 1;
+                }
+                for floor in [-1.0, -0.5, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0] {
+                    let a = ElementQuality.eval_above(&bnd, &c.pts, *t, &x, floor);
+                    if q > floor {
+                        assert_eq!(a.to_bits(), q.to_bits(), "{t:?} floor {floor}");
+                    } else {
+                        assert!(a <= floor, "{t:?} floor {floor}: {a} for {q}");
+                        cut += usize::from(a != q);
+                    }
+                }
+            }
+        }
+        assert!(curved > 100 && cut > 0, "{curved} {cut}");
+    }
 
     #[test]
     fn pieces_give_one_minus_skewness_and_their_gradients() {

@@ -78,7 +78,7 @@ fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64, qs: &mut Vec<f
     for &t in star {
         let tv = m.tets[t as usize];
         let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
-        let q = m.quality_at(tv, &c);
+        let q = m.quality_above(tv, &c, floor);
         qs.push(q);
         lo = lo.min(q);
         if lo <= floor {
