@@ -135,6 +135,8 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
     }
     let mut best: Option<(f64, P3)> = None;
     for p in cands.into_iter().flatten() {
+        // What a candidate must beat: the old minimum and the best candidate so far.
+        let floor = best.map_or(old + eps, |b| b.0.max(old + eps));
         let mut worst = f64::INFINITY;
         for &t in &s.touched {
             let tv = m.tets[t as usize];
@@ -143,13 +145,12 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
             }
             let nv = tv.map(|x| if x == r { k } else { x });
             let c = nv.map(|x| if x == k { p } else { m.pts[x as usize] });
-            let floor = best.map_or(old + eps, |b| b.0.max(old + eps));
             worst = worst.min(m.quality_above(nv, &c, floor));
-            if worst <= old + eps || best.is_some_and(|b| worst <= b.0) {
+            if worst <= floor {
                 break;
             }
         }
-        if worst > old + eps && best.map_or(true, |b| worst > b.0) {
+        if worst > floor {
             best = Some((worst, p));
         }
     }

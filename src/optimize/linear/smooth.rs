@@ -71,7 +71,8 @@ fn min_norm_point(g: &[[f64; 3]]) -> [f64; 3] {
 }
 
 /// Minimum quality of the star of `v` with `v` at `p` (each tet's into `qs`); stops early
-/// (returning a value <= `floor`) as soon as some tet is not above `floor`.
+/// (returning a value <= `floor`) as soon as some tet is not above `floor`. The values in
+/// `qs` are exact when the result is above `floor` (the only case they are used in).
 fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64, qs: &mut Vec<f64>) -> f64 {
     let mut lo = f64::INFINITY;
     qs.clear();
