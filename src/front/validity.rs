@@ -13,7 +13,7 @@
 
 use super::grid::Aabb;
 use crate::geom::distance::point_triangle_dist2;
-use crate::geom::predicates::{orient3d, point_in_closed_tet, segment_triangle_conflict};
+use crate::geom::predicates::{orient3d, segment_triangle_conflict_by, Plane};
 use crate::geom::vec3::*;
 
 pub use crate::geom::shape::TET_OUT_FACES;
@@ -99,6 +99,8 @@ pub fn check(
     if tet_det(tp[0], tp[1], tp[2], tp[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt() {
         return Err(Conflict::Degenerate);
     }
+    // T's outward face planes: every nearby front vertex is tested against them.
+    let planes = TET_OUT_FACES.map(|g| Plane::new(tp[g[0]], tp[g[1]], tp[g[2]]));
     let tb = Aabb::of(&tp);
     let tb_far = Aabb {
         lo: [
@@ -187,18 +189,21 @@ pub fn check(
                 min_gap_b = min_gap_b.min(g);
             }
         }
-        if separated(&t, &tp, &fv, &fp) {
+        if separated(&t, &planes, &fv, &fp) {
             continue;
         }
-        // Front vertices inside closed T.
+        // Front vertices inside closed T: on the inner side of (or on) every face plane.
         for k in 0..3 {
-            if loc[k].is_none() && point_in_closed_tet(fp[k], tp[0], tp[1], tp[2], tp[3]) {
+            if loc[k].is_none() && planes.iter().all(|pl| pl.orient(fp[k]) <= 0) {
                 return Err(Conflict::VertexInside(fv));
             }
         }
         // New edges of T against F.
+        let fplane = Plane::new(fp[0], fp[1], fp[2]);
         for i in 0..3 {
-            if segment_triangle_conflict([tp[i], tp[3]], [t[i], t[3]], fp, fv) {
+            if segment_triangle_conflict_by([tp[i], tp[3]], [t[i], t[3]], fp, fv, |x| {
+                fplane.orient(x)
+            }) {
                 return Err(Conflict::NewEdgeCrosses(fv));
             }
         }
@@ -209,10 +214,11 @@ pub fn check(
             if loc[i].is_some() && loc[j].is_some() {
                 continue; // an edge of T itself
             }
-            for g in &TET_OUT_FACES[1..] {
+            for (g, pl) in TET_OUT_FACES.iter().zip(&planes).skip(1) {
                 let gid = [t[g[0]], t[g[1]], t[g[2]]];
                 let gp = [tp[g[0]], tp[g[1]], tp[g[2]]];
-                if segment_triangle_conflict([fp[i], fp[j]], [ei, ej], gp, gid) {
+                if segment_triangle_conflict_by([fp[i], fp[j]], [ei, ej], gp, gid, |x| pl.orient(x))
+                {
                     return Err(Conflict::EdgeCrossesNewFace(fv));
                 }
             }
@@ -227,16 +233,15 @@ pub fn check(
     })
 }
 
-/// Is F strictly outside one of T's face planes (touching only at T's own vertices on
-/// that face)? Cheap early exit for most nearby faces.
-fn separated(t: &[u32; 4], tp: &[P3; 4], fv: &[u32; 3], fp: &[P3; 3]) -> bool {
-    'faces: for face in &TET_OUT_FACES {
-        let (x, y, z) = (tp[face[0]], tp[face[1]], tp[face[2]]);
+/// Is F strictly outside one of T's face planes (`planes`, outward; touching only at T's
+/// own vertices on that face)? Cheap early exit for most nearby faces.
+fn separated(t: &[u32; 4], planes: &[Plane; 4], fv: &[u32; 3], fp: &[P3; 3]) -> bool {
+    'faces: for (face, pl) in TET_OUT_FACES.iter().zip(planes) {
         for k in 0..3 {
             if face.iter().any(|&i| t[i] == fv[k]) {
                 continue;
             }
-            if orient3d(x, y, z, fp[k]) <= 0 {
+            if pl.orient(fp[k]) <= 0 {
                 continue 'faces;
             }
         }

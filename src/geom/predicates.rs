@@ -3,7 +3,9 @@
 //! Every topological decision in curvetet (orientation, point in tetrahedron, segment or
 //! triangle crossing) goes through here. The signs come from Shewchuk's adaptive exact
 //! predicates (`robust` crate), so they are right for all finite f64 inputs within the
-//! range the surface checks admit; there is no epsilon anywhere in this file.
+//! range the surface checks admit; there is no epsilon anywhere in this file (the one
+//! error bound, [`Plane`]'s, is Shewchuk's own filter: it only decides when the sign is
+//! certain and defers to [`orient3d`] otherwise).
 //!
 //! Intersection tests take vertex *identities* (`u32` ids) besides coordinates, so that
 //! elements sharing a vertex or an edge are judged by topology: touching at a shared
@@ -25,6 +27,65 @@ pub fn orient3d(a: P3, b: P3, c: P3, d: P3) -> i32 {
         -1
     } else {
         0
+    }
+}
+
+/// Shewchuk's error bound of the floating-point 3x3 orientation determinant relative to
+/// its permanent ((7 + 56 eps) eps, eps = 2^-53, in `robust`'s `orient3d`), rounded up.
+const O3D_ERR_BOUND: f64 = 8.0 * (f64::EPSILON / 2.0);
+
+/// The oriented plane through `a`, `b`, `c`, prepared for many exact orientation tests:
+/// [`Plane::orient`]`(d)` is [`orient3d`]`(a, b, c, d)`, decided by a few flops when the
+/// floating-point determinant clears Shewchuk's error bound (the same filter `robust`
+/// applies first) and by [`orient3d`] when it does not. The validity tests of the front
+/// check every nearby front vertex against a candidate's four face planes: with the
+/// normal and its error weights computed once per plane, each test costs a third of a
+/// full `orient3d` call.
+#[derive(Clone, Copy, Debug)]
+pub struct Plane {
+    p: [P3; 3],
+    /// (b − a) × (c − a).
+    n: P3,
+    /// The permanent's weights: |u_j v_k| + |u_k v_j| per component of `n`.
+    w: P3,
+}
+
+impl Plane {
+    /// The plane through `a`, `b`, `c` (normal (b − a) × (c − a)).
+    #[inline]
+    pub fn new(a: P3, b: P3, c: P3) -> Plane {
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let prod = |i: usize, j: usize| (u[i] * v[j], u[j] * v[i]);
+        let (x0, x1) = prod(1, 2);
+        let (y0, y1) = prod(2, 0);
+        let (z0, z1) = prod(0, 1);
+        Plane {
+            p: [a, b, c],
+            n: [x0 - x1, y0 - y1, z0 - z1],
+            w: [
+                x0.abs() + x1.abs(),
+                y0.abs() + y1.abs(),
+                z0.abs() + z1.abs(),
+            ],
+        }
+    }
+
+    /// [`orient3d`]`(a, b, c, d)`, exact.
+    #[inline]
+    pub fn orient(&self, d: P3) -> i32 {
+        let a = self.p[0];
+        let r = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        let det = self.n[0] * r[0] + self.n[1] * r[1] + self.n[2] * r[2];
+        let perm = self.w[0] * r[0].abs() + self.w[1] * r[1].abs() + self.w[2] * r[2].abs();
+        let bound = O3D_ERR_BOUND * perm;
+        if det > bound {
+            1
+        } else if det < -bound {
+            -1
+        } else {
+            orient3d(self.p[0], self.p[1], self.p[2], d)
+        }
     }
 }
 
@@ -134,8 +195,14 @@ fn point_in_tri_2d(pr: Proj, s: i32, x: P3, a: P3, b: P3, c: P3) -> bool {
 /// Does the closed segment (p, q) meet the closed triangle (a, b, c)? No shared-vertex
 /// logic: any contact counts. The triangle must not be degenerate.
 pub fn segment_meets_triangle(p: P3, q: P3, a: P3, b: P3, c: P3) -> bool {
-    let sp = orient3d(a, b, c, p);
-    let sq = orient3d(a, b, c, q);
+    segment_meets_triangle_by(p, q, a, b, c, |x| orient3d(a, b, c, x))
+}
+
+/// [`segment_meets_triangle`] with the triangle's plane test `side(x)` =
+/// [`orient3d`]`(a, b, c, x)` given (a [`Plane`]'s, say).
+fn segment_meets_triangle_by(p: P3, q: P3, a: P3, b: P3, c: P3, side: impl Fn(P3) -> i32) -> bool {
+    let sp = side(p);
+    let sq = side(q);
     if sp * sq > 0 {
         return false;
     }
@@ -159,19 +226,32 @@ pub fn segment_meets_triangle(p: P3, q: P3, a: P3, b: P3, c: P3) -> bool {
 /// Does segment `s` (ids `sid`) meet triangle `t` (ids `tid`) anywhere other than at the
 /// vertices and edge they share? Exact. Points with equal ids are taken to be equal.
 pub fn segment_triangle_conflict(s: [P3; 2], sid: [u32; 2], t: [P3; 3], tid: [u32; 3]) -> bool {
+    segment_triangle_conflict_by(s, sid, t, tid, |x| orient3d(t[0], t[1], t[2], x))
+}
+
+/// [`segment_triangle_conflict`] with the triangle's plane test `side(x)` =
+/// [`orient3d`]`(t[0], t[1], t[2], x)` given (a [`Plane`]'s, say).
+pub fn segment_triangle_conflict_by(
+    s: [P3; 2],
+    sid: [u32; 2],
+    t: [P3; 3],
+    tid: [u32; 3],
+    side: impl Fn(P3) -> i32,
+) -> bool {
     let in_t = |id: u32| tid.iter().position(|&x| x == id);
     match (in_t(sid[0]), in_t(sid[1])) {
         (Some(_), Some(_)) => false, // the segment is an edge of the triangle
-        (Some(j), None) => shared_vertex_conflict(t, j, s[1]),
-        (None, Some(j)) => shared_vertex_conflict(t, j, s[0]),
-        (None, None) => segment_meets_triangle(s[0], s[1], t[0], t[1], t[2]),
+        (Some(j), None) => shared_vertex_conflict(t, j, side(s[1]), s[1]),
+        (None, Some(j)) => shared_vertex_conflict(t, j, side(s[0]), s[0]),
+        (None, None) => segment_meets_triangle_by(s[0], s[1], t[0], t[1], t[2], side),
     }
 }
 
-/// Segment from triangle vertex `t[j]` to `q`: does it enter the closed triangle beyond
-/// `t[j]`? Only possible when `q` is coplanar and inside the closed angle at `t[j]`.
-fn shared_vertex_conflict(t: [P3; 3], j: usize, q: P3) -> bool {
-    if orient3d(t[0], t[1], t[2], q) != 0 {
+/// Segment from triangle vertex `t[j]` to `q` (on side `side_q` of the triangle's plane):
+/// does it enter the closed triangle beyond `t[j]`? Only possible when `q` is coplanar
+/// and inside the closed angle at `t[j]`.
+fn shared_vertex_conflict(t: [P3; 3], j: usize, side_q: i32, q: P3) -> bool {
+    if side_q != 0 {
         return false;
     }
     let v = t[j];
@@ -279,6 +359,51 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn plane_orient_is_orient3d() {
+        use rand::{Rng, SeedableRng};
+        // Random points, points nudged off exactly coplanar ones by a few ulps (where the
+        // filter must defer to the exact predicate), and exactly coplanar ones.
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        let mut r3 = |s: f64| -> P3 { std::array::from_fn(|_| s * rng.random_range(-1.0..1.0)) };
+        let (mut n, mut zero, mut deferred, mut random_deferred) = (0, 0, 0, 0);
+        for scale in [1e-3, 1.0, 1e3] {
+            for _ in 0..200 {
+                let (a, b, c) = (r3(scale), r3(scale), r3(scale));
+                let pl = Plane::new(a, b, c);
+                let mut pts: Vec<P3> = (0..20).map(|_| r3(scale)).collect();
+                for k in 0..20 {
+                    // On segment ab (coplanar up to rounding of the construction), and
+                    // that point moved by k ulps in z.
+                    let t = k as f64 / 20.0;
+                    let mut d: P3 = std::array::from_fn(|i| a[i] + t * (b[i] - a[i]));
+                    pts.push(d);
+                    for _ in 0..k % 4 {
+                        d[2] = d[2].next_up();
+                    }
+                    pts.push(d);
+                }
+                pts.extend([a, b, c]);
+                for (i, d) in pts.into_iter().enumerate() {
+                    let exact = orient3d(a, b, c, d);
+                    assert_eq!(pl.orient(d), exact, "{a:?} {b:?} {c:?} {d:?}");
+                    n += 1;
+                    zero += usize::from(exact == 0);
+                    let r: P3 = std::array::from_fn(|i| d[i] - a[i]);
+                    let det = pl.n[0] * r[0] + pl.n[1] * r[1] + pl.n[2] * r[2];
+                    let perm = pl.w[0] * r[0].abs() + pl.w[1] * r[1].abs() + pl.w[2] * r[2].abs();
+                    let defer = det.abs() <= O3D_ERR_BOUND * perm;
+                    deferred += usize::from(defer);
+                    random_deferred += usize::from(defer && i < 20);
+                }
+            }
+        }
+        // Every exact zero was deferred (else the filter could not have matched it), and
+        // so were some of the nudged points, but almost no random one.
+        assert!(zero > 1000 && deferred > zero, "{n} {zero} {deferred}");
+        assert!(random_deferred * 1000 < n, "{n} {random_deferred}");
     }
 
     #[test]
