@@ -79,6 +79,9 @@ struct Face {
     /// Current queue class (0: thin wedge, 1: by size) and key.
     qclass: u8,
     qkey: f64,
+    /// A lower bound of the distance from the face's centroid to the nearest surface
+    /// vertex (0: unknown), for [`SizeField::at_near`].
+    dnear: f64,
 }
 
 /// A queue entry: (tries, class, key, face, version); smallest first.
@@ -244,6 +247,7 @@ impl<'a> Mesher<'a> {
             ver: 0,
             qclass: 1,
             qkey: 0.0,
+            dnear: 0.0,
         });
         for k in 0..3 {
             self.edges.insert((v[k], v[(k + 1) % 3]), id);
@@ -500,7 +504,9 @@ impl<'a> Mesher<'a> {
             normalize(flat_n)
         };
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let l_field = self.size_at(c);
+        let (l_field, dnear) = self.size.at_near(c, f.dnear);
+        let l_field = self.size_scale * l_field;
+        self.faces[fid as usize].dnear = dnear;
         let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);
         let a = axpy(c, h, n);
@@ -803,11 +809,28 @@ impl<'a> Mesher<'a> {
         self.tets.push(t);
         self.tet_alive.push(true);
         self.kill_face(base);
+        // (The point the base face's bound is for: its centroid as `advance` computes it.)
+        let base_c = {
+            let p = self.face_pts(base);
+            centroid3(p[0], p[1], p[2])
+        };
+        let base_dnear = self.faces[base as usize].dnear;
         for g in &TET_OUT_FACES[1..] {
             let v = [t[g[0]], t[g[1]], t[g[2]]];
             match self.face_map.get(&key3(v)) {
                 Some(&other) => self.kill_face(other),
-                None => self.add_face(v),
+                None => {
+                    self.add_face(v);
+                    // The distance to the nearest surface vertex is 1-Lipschitz; the
+                    // margins cover the rounding of both distances.
+                    if base_dnear > 0.0 {
+                        let c = centroid3(tp[g[0]], tp[g[1]], tp[g[2]]);
+                        let d = (base_dnear - 1.000001 * dist(c, base_c)) * (1.0 - 1e-9);
+                        if let Some(f) = self.faces.last_mut() {
+                            f.dnear = d.max(0.0);
+                        }
+                    }
+                }
             }
         }
     }

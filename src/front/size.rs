@@ -6,6 +6,13 @@
 //! `min_i (h_i + g |x - x_i|)` over the nearest surface vertices, capped at the largest
 //! boundary size. So the interior never gets coarser than the coarsest boundary triangle
 //! and sizes change by at most a factor (1 + g) per element.
+//!
+//! Deep inside, where every vertex is so far that even the smallest boundary size plus
+//! g times the distance reaches the cap, the field is the cap whichever vertices are
+//! nearest. [`SizeField::at_near`] takes a lower bound of that distance (the front
+//! passes one from each face to the faces it creates: the distance to the nearest
+//! vertex is 1-Lipschitz) and skips the k-nearest query there, with the same value bit
+//! for bit.
 
 use crate::geom::vec3::{dist, P3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
@@ -27,6 +34,8 @@ pub enum SizeField {
         hmax: f64,
         /// Nearest-vertex search over `pts`.
         tree: ImmutableKdTree<f64, 3>,
+        /// Smallest of `h`.
+        hmin: f64,
     },
 }
 
@@ -91,37 +100,56 @@ impl SizeField {
         let pts: Vec<P3> = keep.iter().map(|&i| corner_pts[i]).collect();
         let h: Vec<f64> = keep.iter().map(|&i| h[i]).collect();
         let tree = ImmutableKdTree::new_from_slice(&pts).expect("kd-tree of surface vertices");
+        let hmin = h.iter().cloned().fold(f64::INFINITY, f64::min);
         SizeField::Graded {
             pts,
             h,
             g,
             hmax,
             tree,
+            hmin,
         }
     }
 
     /// Target edge length at `x`.
     pub fn at(&self, x: P3) -> f64 {
+        self.at_near(x, 0.0).0
+    }
+
+    /// Target edge length at `x`, given `floor`, a lower bound of the distance from `x`
+    /// to the nearest surface vertex (0 when nothing is known); also returns such a
+    /// bound (the distance itself, less a margin for rounding, when it was computed).
+    pub fn at_near(&self, x: P3, floor: f64) -> (f64, f64) {
         match self {
-            SizeField::Uniform(l) => *l,
+            SizeField::Uniform(l) => (*l, 0.0),
             SizeField::Graded {
                 pts,
                 h,
                 g,
                 hmax,
                 tree,
+                hmin,
             } => {
+                // Every term of the minimum below is at least hmin + g * (distance to
+                // the nearest vertex), rounding being monotone: when that reaches the
+                // cap, the value is the cap.
+                if *hmin + *g * floor >= *hmax {
+                    return (*hmax, floor);
+                }
                 let k = NonZero::new(8usize.min(pts.len()).max(1)).unwrap();
                 let near = tree
                     .query(&x)
                     .nearest_n::<SquaredEuclidean<f64>>(k)
                     .execute();
                 let mut best = *hmax;
+                let mut nearest = f64::INFINITY;
                 for r in near {
                     let i = r.item as usize;
-                    best = best.min(h[i] + g * r.distance.sqrt());
+                    let d = r.distance.sqrt();
+                    nearest = nearest.min(d);
+                    best = best.min(h[i] + g * d);
                 }
-                best
+                (best, (nearest * (1.0 - 1e-9)).max(0.0))
             }
         }
     }
@@ -132,5 +160,72 @@ impl SizeField {
             SizeField::Uniform(l) => *l,
             SizeField::Graded { h, .. } => h.iter().cloned().fold(f64::INFINITY, f64::min),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// A graded field on random points of the unit sphere.
+    fn sphere_field(rng: &mut rand::rngs::StdRng) -> (SizeField, Vec<P3>) {
+        let mut pts = Vec::new();
+        while pts.len() < 400 {
+            let p: P3 = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+            let r = dist(p, [0.0; 3]);
+            if r > 0.1 && r <= 1.0 {
+                pts.push(p.map(|x| x / r));
+            }
+        }
+        // Edges to each point's two nearest neighbours: their lengths set the sizes.
+        let mut edges: Vec<[u32; 2]> = Vec::new();
+        for (i, &p) in pts.iter().enumerate() {
+            let mut by: Vec<(f64, usize)> = (0..pts.len())
+                .filter(|&j| j != i)
+                .map(|j| (dist(p, pts[j]), j))
+                .collect();
+            by.sort_by(|a, b| a.0.total_cmp(&b.0));
+            for &(_, j) in &by[..2] {
+                edges.push([i as u32, j as u32]);
+            }
+        }
+        let f = SizeField::graded(pts.clone(), &edges, 0.2);
+        (f, pts)
+    }
+
+    #[test]
+    fn at_near_is_at_given_a_true_distance_floor() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let (f, pts) = sphere_field(&mut rng);
+        let SizeField::Graded { hmin, hmax, g, .. } = &f else {
+            unreachable!()
+        };
+        let depth = (hmax - hmin) / g;
+        assert!(depth < 0.9, "the test needs points deep enough: {depth}");
+        let (mut skipped, mut queried) = (0, 0);
+        for _ in 0..4000 {
+            let x: P3 = std::array::from_fn(|_| rng.random_range(-0.35..0.35));
+            let nearest = pts
+                .iter()
+                .map(|&p| dist(p, x))
+                .fold(f64::INFINITY, f64::min);
+            let exact = f.at(x);
+            // Any floor at most the true distance gives the same value, bit for bit.
+            for floor in [0.0, 0.5 * nearest, 0.999 * nearest] {
+                let (v, bound) = f.at_near(x, floor);
+                assert_eq!(v.to_bits(), exact.to_bits(), "{x:?} floor {floor}");
+                assert!(bound <= nearest, "{bound} > {nearest}");
+                if hmin + g * floor >= *hmax {
+                    skipped += 1;
+                    assert_eq!(v, *hmax);
+                } else {
+                    queried += 1;
+                    // A computed bound is the distance itself, less the margin.
+                    assert!(bound >= 0.999_999 * nearest, "{bound} vs {nearest}");
+                }
+            }
+        }
+        assert!(skipped > 100 && queried > 100, "{skipped} {queried}");
     }
 }
