@@ -19,14 +19,22 @@ pub struct Aabb {
 }
 
 impl Aabb {
-    /// The box of a set of points.
+    /// The box of a set of (finite) points.
+    #[inline]
     pub fn of(pts: &[P3]) -> Aabb {
         let mut lo = pts[0];
         let mut hi = pts[0];
         for p in &pts[1..] {
             for d in 0..3 {
-                lo[d] = lo[d].min(p[d]);
-                hi[d] = hi[d].max(p[d]);
+                // Plain comparisons rather than f64::min/max: the same for finite
+                // coordinates, without the NaN handling (this runs for every front face
+                // near every candidate tet).
+                if p[d] < lo[d] {
+                    lo[d] = p[d];
+                }
+                if p[d] > hi[d] {
+                    hi[d] = p[d];
+                }
             }
         }
         Aabb { lo, hi }
