@@ -91,12 +91,7 @@ pub fn generate_with_progress(
     progress: &mut dyn FnMut(f64, &str) -> bool,
 ) -> Result<Generated> {
     opts.validate()?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.threads)
-        .build()
-        .map_err(|e| {
-            Error::InvalidArgument(format!("cannot start {} threads: {e}", opts.threads))
-        })?;
+    let pool = crate::threads::pool(opts.threads)?;
     generate_inner(surface, opts, progress, &pool)
 }
 

@@ -16,6 +16,7 @@ pub mod mesh;
 pub mod optimize;
 pub mod options;
 pub mod surface;
+pub mod threads;
 
 pub use error::{Error, Result, SurfaceDefect};
 pub use generate::{generate, generate_with_progress, Generated};
