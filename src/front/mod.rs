@@ -12,6 +12,7 @@
 mod cavity;
 mod diagnose;
 mod grid;
+mod queue;
 mod repair;
 pub mod size;
 pub mod validity;
@@ -24,10 +25,9 @@ use crate::geom::vec3::*;
 use crate::options::Options;
 use crate::{Error, Result};
 use grid::{Aabb, FaceGrid, PointGrid};
+use queue::FaceQueue;
 use rustc_hash::FxHashMap as HashMap;
 use size::{regular_height, SizeField};
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 use validity::{FaceRef, TET_OUT_FACES};
 
 /// What the front produced: straight-sided tets on low-order vertices.
@@ -84,23 +84,9 @@ struct Face {
     dnear: f64,
 }
 
-/// A queue entry: (tries, class, key, face, version); smallest first.
-type QEntry = Reverse<(u8, u8, Key, u32, u32)>;
-
 /// Wedges (unmeshed dihedral angle between neighbouring front faces) below this are
 /// closed first: left for later they become the pockets an advancing front gets stuck in.
 const WEDGE_FIRST_DEG: f64 = 75.0;
-
-/// Ordered f64 for the queue.
-#[derive(Clone, Copy, PartialEq, PartialOrd)]
-struct Key(f64);
-impl Eq for Key {}
-#[allow(clippy::derive_ord_xor_partial_ord)]
-impl Ord for Key {
-    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&o.0)
-    }
-}
 
 /// A candidate apex.
 #[derive(Clone, Copy)]
@@ -142,7 +128,7 @@ pub(crate) struct Mesher<'a> {
     face_map: HashMap<[u32; 3], u32>,
     btri_map: HashMap<[u32; 3], u32>,
     bedge_mid: HashMap<(u32, u32), u32>,
-    heap: BinaryHeap<QEntry>,
+    queue: FaceQueue,
     /// Directed edge (a, b) of a live front face -> that face.
     edges: HashMap<(u32, u32), u32>,
     grid: FaceGrid,
@@ -204,7 +190,7 @@ impl<'a> Mesher<'a> {
             face_map: HashMap::with_capacity_and_hasher(surf_tris.len() * 2, Default::default()),
             btri_map: HashMap::with_capacity_and_hasher(surf_tris.len(), Default::default()),
             bedge_mid,
-            heap: BinaryHeap::new(),
+            queue: FaceQueue::default(),
             edges: HashMap::with_capacity_and_hasher(surf_tris.len() * 6, Default::default()),
             grid: FaceGrid::new(bounds, cell, max_cells),
             vgrid: PointGrid::new(bounds, cell, max_cells),
@@ -317,8 +303,7 @@ impl<'a> Mesher<'a> {
         } else {
             (2, face_size(&p))
         };
-        self.heap
-            .push(Reverse((f.tries, class, Key(key), id, f.ver)));
+        self.queue.push(f.tries, class, key, id, f.ver);
     }
 
     fn kill_face(&mut self, id: u32) {
@@ -389,7 +374,7 @@ impl<'a> Mesher<'a> {
         let max_steps = 200 * self.surf_tris.len() as u64 + 1_000_000;
         let max_repairs = 50 + self.surf_tris.len() as u64;
         let mut last_report = 0.0;
-        while let Some(Reverse((tries, _, _, fid, ver))) = self.heap.pop() {
+        while let Some((tries, fid, ver)) = self.queue.pop() {
             let f = self.faces[fid as usize];
             if !f.alive || f.tries != tries || f.ver != ver {
                 continue;

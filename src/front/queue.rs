@@ -1,0 +1,112 @@
+//! The front's face queue: smallest (tries, class, key, face, version) first.
+//!
+//! One binary heap per (tries, class) pair (tries 0..=3, class 0..=2), each ordered by
+//! (key, face, version) packed into two integers: the same order as the tuple, with
+//! 16-byte entries and integer comparisons instead of a 24-byte tuple compared field by
+//! field (f64 keys by `total_cmp`). The heaps hold every face of a large front, so their
+//! sifting is a visible share of the front's time at 1M tets.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+/// Largest number of tries a face is queued with.
+pub const MAX_TRIES: u8 = 3;
+/// Number of queue classes.
+pub const CLASSES: u8 = 3;
+
+/// An f64 as a u64 with the order of `f64::total_cmp`.
+#[inline]
+fn total_order_bits(x: f64) -> u64 {
+    let b = x.to_bits() as i64;
+    // total_cmp's transform (flip the magnitude bits of negatives), then the sign bit so
+    // that unsigned comparison orders negatives first.
+    ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
+}
+
+/// The queue.
+#[derive(Default)]
+pub struct FaceQueue {
+    heaps: Vec<BinaryHeap<Reverse<(u64, u64)>>>,
+}
+
+impl FaceQueue {
+    /// Queue face `id` (version `ver`) with `tries` (at most [`MAX_TRIES`]), `class`
+    /// (below [`CLASSES`]) and `key`.
+    #[inline]
+    pub fn push(&mut self, tries: u8, class: u8, key: f64, id: u32, ver: u32) {
+        debug_assert!(tries <= MAX_TRIES && class < CLASSES);
+        if self.heaps.is_empty() {
+            self.heaps = (0..(MAX_TRIES as usize + 1) * CLASSES as usize)
+                .map(|_| BinaryHeap::new())
+                .collect();
+        }
+        let h = tries as usize * CLASSES as usize + class as usize;
+        self.heaps[h].push(Reverse((
+            total_order_bits(key),
+            (id as u64) << 32 | ver as u64,
+        )));
+    }
+
+    /// The smallest entry: (tries, face, version).
+    #[inline]
+    pub fn pop(&mut self) -> Option<(u8, u32, u32)> {
+        for (h, heap) in self.heaps.iter_mut().enumerate() {
+            if let Some(Reverse((_, iv))) = heap.pop() {
+                let tries = (h / CLASSES as usize) as u8;
+                return Some((tries, (iv >> 32) as u32, iv as u32));
+            }
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn pops_in_the_order_of_the_tuple() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(9);
+        let mut q = FaceQueue::default();
+        let mut reference = BinaryHeap::new();
+        let keys = [0.0, -0.0, 1e-300, 0.5, 0.5, 3.0, 75.0, f64::INFINITY, -2.0];
+        for i in 0..3000u32 {
+            let tries = rng.random_range(0..=MAX_TRIES);
+            let class = rng.random_range(0..CLASSES);
+            let key = if rng.random_bool(0.5) {
+                keys[rng.random_range(0..keys.len())]
+            } else {
+                rng.random_range(0.0..100.0)
+            };
+            let id = rng.random_range(0..500u32);
+            let ver = rng.random_range(0..4u32);
+            q.push(tries, class, key, id, ver);
+            reference.push(Reverse((tries, class, TotalF64(key), id, ver, i)));
+            // Interleave pops, as the front does.
+            if rng.random_bool(0.3) {
+                let Reverse((t, _, _, id, ver, _)) = reference.pop().unwrap();
+                assert_eq!(q.pop(), Some((t, id, ver)));
+            }
+        }
+        while let Some(Reverse((t, _, _, id, ver, _))) = reference.pop() {
+            assert_eq!(q.pop(), Some((t, id, ver)));
+        }
+        assert_eq!(q.pop(), None);
+    }
+
+    /// f64 ordered by total_cmp (what the front's queue key was).
+    #[derive(PartialEq)]
+    struct TotalF64(f64);
+    impl Eq for TotalF64 {}
+    impl PartialOrd for TotalF64 {
+        fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
+            Some(self.cmp(o))
+        }
+    }
+    impl Ord for TotalF64 {
+        fn cmp(&self, o: &Self) -> std::cmp::Ordering {
+            self.0.total_cmp(&o.0)
+        }
+    }
+}
