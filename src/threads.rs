@@ -16,28 +16,22 @@
 
 use crate::{Error, Result};
 
-/// A rayon pool of `threads` workers (0: one per CPU), pinned as the module docs say.
+/// A rayon pool of `threads` workers (0: as many as rayon chooses, one per CPU by
+/// default), pinned as the module docs say.
 pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
-    let cpus = if pinning_wanted() {
-        allowed_cpus()
-    } else {
-        Vec::new()
-    };
-    // The pool's size, as rayon decides it for 0.
-    let n = match threads {
-        0 => std::env::var("RAYON_NUM_THREADS")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .filter(|&n: &usize| n > 0)
-            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())),
-        t => t,
-    };
-    let mut b = rayon::ThreadPoolBuilder::new().num_threads(threads);
-    if n > 1 && n == cpus.len() {
-        b = b.start_handler(move |i| pin_current_thread(cpus[i % cpus.len()]));
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::InvalidArgument(format!("cannot start {threads} threads: {e}")))?;
+    let n = pool.current_num_threads();
+    if n > 1 && pinning_wanted() {
+        let cpus = allowed_cpus();
+        if n == cpus.len() {
+            // Every worker runs this once, with its own index.
+            pool.broadcast(|ctx| pin_current_thread(cpus[ctx.index()]));
+        }
     }
-    b.build()
-        .map_err(|e| Error::InvalidArgument(format!("cannot start {threads} threads: {e}")))
+    Ok(pool)
 }
 
 /// False when `CURVETET_PIN_THREADS` is `0`, `false`, `no` or `off`.

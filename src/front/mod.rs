@@ -437,7 +437,14 @@ impl<'a> Mesher<'a> {
 
     /// Target edge length at `x`: the size field times this run's factor.
     fn size_at(&self, x: P3) -> f64 {
-        self.size_scale * self.size.at(x)
+        self.size_near(x, 0.0).0
+    }
+
+    /// [`Mesher::size_at`] given and returning a lower bound of the distance from `x` to
+    /// the nearest surface vertex ([`SizeField::at_near`]).
+    fn size_near(&self, x: P3, dnear: f64) -> (f64, f64) {
+        let (l, d) = self.size.at_near(x, dnear);
+        (self.size_scale * l, d)
     }
 
     fn face_pts(&self, fid: u32) -> [P3; 3] {
@@ -489,8 +496,7 @@ impl<'a> Mesher<'a> {
             normalize(flat_n)
         };
         let lf = (dist(fp[0], fp[1]) + dist(fp[1], fp[2]) + dist(fp[2], fp[0])) / 3.0;
-        let (l_field, dnear) = self.size.at_near(c, f.dnear);
-        let l_field = self.size_scale * l_field;
+        let (l_field, dnear) = self.size_near(c, f.dnear);
         self.faces[fid as usize].dnear = dnear;
         let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);

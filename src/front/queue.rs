@@ -23,10 +23,13 @@ fn total_order_bits(x: f64) -> u64 {
     ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
 }
 
+/// Number of heaps: one per (tries, class).
+const HEAPS: usize = (MAX_TRIES as usize + 1) * CLASSES as usize;
+
 /// The queue.
 #[derive(Default)]
 pub struct FaceQueue {
-    heaps: Vec<BinaryHeap<Reverse<(u64, u64)>>>,
+    heaps: [BinaryHeap<Reverse<(u64, u64)>>; HEAPS],
 }
 
 impl FaceQueue {
@@ -35,11 +38,6 @@ impl FaceQueue {
     #[inline]
     pub fn push(&mut self, tries: u8, class: u8, key: f64, id: u32, ver: u32) {
         debug_assert!(tries <= MAX_TRIES && class < CLASSES);
-        if self.heaps.is_empty() {
-            self.heaps = (0..(MAX_TRIES as usize + 1) * CLASSES as usize)
-                .map(|_| BinaryHeap::new())
-                .collect();
-        }
         let h = tries as usize * CLASSES as usize + class as usize;
         self.heaps[h].push(Reverse((
             total_order_bits(key),

@@ -13,7 +13,9 @@
 
 use super::grid::Aabb;
 use crate::geom::distance::point_triangle_dist2;
-use crate::geom::predicates::{orient3d, segment_triangle_conflict_by, Plane};
+use crate::geom::predicates::{
+    in_closed_tet, orient3d, segment_triangle_conflict_by, tet_face_planes, Plane,
+};
 use crate::geom::vec3::*;
 
 pub use crate::geom::shape::TET_OUT_FACES;
@@ -100,7 +102,7 @@ pub fn check(
         return Err(Conflict::Degenerate);
     }
     // T's outward face planes: every nearby front vertex is tested against them.
-    let planes = TET_OUT_FACES.map(|g| Plane::new(tp[g[0]], tp[g[1]], tp[g[2]]));
+    let planes = tet_face_planes(&tp);
     let tb = Aabb::of(&tp);
     let tb_far = Aabb {
         lo: [
@@ -192,9 +194,9 @@ pub fn check(
         if separated(&t, &planes, &fv, &fp) {
             continue;
         }
-        // Front vertices inside closed T: on the inner side of (or on) every face plane.
+        // Front vertices inside closed T.
         for k in 0..3 {
-            if loc[k].is_none() && planes.iter().all(|pl| pl.orient(fp[k]) <= 0) {
+            if loc[k].is_none() && in_closed_tet(&planes, fp[k]) {
                 return Err(Conflict::VertexInside(fv));
             }
         }

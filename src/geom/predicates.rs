@@ -11,6 +11,7 @@
 //! elements sharing a vertex or an edge are judged by topology: touching at a shared
 //! vertex or along a shared edge is not a conflict, touching anywhere else is.
 
+use super::shape::TET_OUT_FACES;
 use super::vec3::P3;
 use robust::{Coord, Coord3D};
 
@@ -74,19 +75,41 @@ impl Plane {
     /// [`orient3d`]`(a, b, c, d)`, exact.
     #[inline]
     pub fn orient(&self, d: P3) -> i32 {
+        self.filtered(d)
+            .unwrap_or_else(|| orient3d(self.p[0], self.p[1], self.p[2], d))
+    }
+
+    /// The sign of [`Plane::orient`] when the floating-point determinant clears the error
+    /// bound, else `None`.
+    #[inline]
+    fn filtered(&self, d: P3) -> Option<i32> {
         let a = self.p[0];
         let r = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
         let det = self.n[0] * r[0] + self.n[1] * r[1] + self.n[2] * r[2];
         let perm = self.w[0] * r[0].abs() + self.w[1] * r[1].abs() + self.w[2] * r[2].abs();
         let bound = O3D_ERR_BOUND * perm;
         if det > bound {
-            1
+            Some(1)
         } else if det < -bound {
-            -1
+            Some(-1)
         } else {
-            orient3d(self.p[0], self.p[1], self.p[2], d)
+            None
         }
     }
+}
+
+/// The outward face planes of the positive tetrahedron `x` (faces in
+/// [`TET_OUT_FACES`] order), for testing many points against it.
+#[inline]
+pub fn tet_face_planes(x: &[P3; 4]) -> [Plane; 4] {
+    TET_OUT_FACES.map(|g| Plane::new(x[g[0]], x[g[1]], x[g[2]]))
+}
+
+/// True when `p` lies in the closed tetrahedron whose outward face planes are `planes`
+/// ([`tet_face_planes`]): on the inner side of, or on, every one.
+#[inline]
+pub fn in_closed_tet(planes: &[Plane; 4], p: P3) -> bool {
+    planes.iter().all(|pl| pl.orient(p) <= 0)
 }
 
 #[inline]
@@ -156,10 +179,7 @@ pub fn collinear(a: P3, b: P3, c: P3) -> bool {
 /// True when `p` lies in the closed tetrahedron (a, b, c, d), which must be positive.
 #[inline]
 pub fn point_in_closed_tet(p: P3, a: P3, b: P3, c: P3, d: P3) -> bool {
-    orient3d(a, b, c, p) >= 0
-        && orient3d(a, c, d, p) >= 0
-        && orient3d(a, d, b, p) >= 0
-        && orient3d(b, d, c, p) >= 0
+    in_closed_tet(&tet_face_planes(&[a, b, c, d]), p)
 }
 
 /// Closed 2D segment-segment intersection (including collinear overlap), in projection `pr`.
@@ -193,14 +213,9 @@ fn point_in_tri_2d(pr: Proj, s: i32, x: P3, a: P3, b: P3, c: P3) -> bool {
 }
 
 /// Does the closed segment (p, q) meet the closed triangle (a, b, c)? No shared-vertex
-/// logic: any contact counts. The triangle must not be degenerate.
-pub fn segment_meets_triangle(p: P3, q: P3, a: P3, b: P3, c: P3) -> bool {
-    segment_meets_triangle_by(p, q, a, b, c, |x| orient3d(a, b, c, x))
-}
-
-/// [`segment_meets_triangle`] with the triangle's plane test `side(x)` =
-/// [`orient3d`]`(a, b, c, x)` given (a [`Plane`]'s, say).
-fn segment_meets_triangle_by(p: P3, q: P3, a: P3, b: P3, c: P3, side: impl Fn(P3) -> i32) -> bool {
+/// logic: any contact counts. The triangle must not be degenerate; `side(x)` is
+/// [`orient3d`]`(a, b, c, x)` (a [`Plane`]'s, say).
+fn segment_meets_triangle(p: P3, q: P3, a: P3, b: P3, c: P3, side: impl Fn(P3) -> i32) -> bool {
     let sp = side(p);
     let sq = side(q);
     if sp * sq > 0 {
@@ -243,7 +258,7 @@ pub fn segment_triangle_conflict_by(
         (Some(_), Some(_)) => false, // the segment is an edge of the triangle
         (Some(j), None) => shared_vertex_conflict(t, j, side(s[1]), s[1]),
         (None, Some(j)) => shared_vertex_conflict(t, j, side(s[0]), s[0]),
-        (None, None) => segment_meets_triangle_by(s[0], s[1], t[0], t[1], t[2], side),
+        (None, None) => segment_meets_triangle(s[0], s[1], t[0], t[1], t[2], side),
     }
 }
 
@@ -391,10 +406,7 @@ mod tests {
                     assert_eq!(pl.orient(d), exact, "{a:?} {b:?} {c:?} {d:?}");
                     n += 1;
                     zero += usize::from(exact == 0);
-                    let r: P3 = std::array::from_fn(|i| d[i] - a[i]);
-                    let det = pl.n[0] * r[0] + pl.n[1] * r[1] + pl.n[2] * r[2];
-                    let perm = pl.w[0] * r[0].abs() + pl.w[1] * r[1].abs() + pl.w[2] * r[2].abs();
-                    let defer = det.abs() <= O3D_ERR_BOUND * perm;
+                    let defer = pl.filtered(d).is_none();
                     deferred += usize::from(defer);
                     random_deferred += usize::from(defer && i < 20);
                 }
