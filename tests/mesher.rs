@@ -123,3 +123,24 @@ fn bad_options_are_clear_errors() {
         assert!(matches!(e, curvetet::Error::InvalidArgument(_)), "{e}");
     }
 }
+
+/// An input large enough for the front to queue interior faces by size class
+/// (`SIZE_CLASS_MIN_TRIANGLES`): the same independent checks, and the small torus's
+/// quality floors.
+#[test]
+fn large_torus_queued_by_size_class() {
+    let (nu, nv) = curvetet::surface::demo::torus_resolution(9000, 1.0, 0.35);
+    let (nodes, tris) = curvetet::surface::demo::torus(nu, nv, 1.0, 0.35);
+    assert!(tris.len() >= curvetet::front::SIZE_CLASS_MIN_TRIANGLES);
+    let n = tris.len();
+    let s = curvetet::Surface::new(nodes, tris, vec![1; n]).expect("the demo torus is valid");
+    let g = generate(&s, &Options::default()).expect("meshes");
+    check_mesh(&s, &g.mesh);
+    let q = &g.report.quality;
+    assert!(
+        q.scaled_jacobian_certified.min >= 0.84,
+        "certified min J / max J {}",
+        q.scaled_jacobian_certified.min
+    );
+    assert!(q.skewness.max <= 0.62, "max skewness {}", q.skewness.max);
+}

@@ -23,6 +23,24 @@ fn total_order_bits(x: f64) -> u64 {
     ((b ^ (((b >> 63) as u64) >> 1) as i64) as u64) ^ (1 << 63)
 }
 
+/// The size class of a face size key (a squared length, see the front's `face_size`):
+/// ⌊log₄ key⌋, i.e. classes of a factor 2 in edge length, read exactly from the float's
+/// exponent bits (no libm call, so the same class on every platform). Faces of one class
+/// pop oldest first (lowest id), which keeps consecutive steps next to each other. Keys
+/// below the normal positive range (zero: a degenerate face) come before every class;
+/// infinite and NaN keys stay after them.
+#[inline]
+pub fn size_class(key: f64) -> f64 {
+    if !key.is_finite() {
+        return key;
+    }
+    if key < f64::MIN_POSITIVE {
+        return f64::NEG_INFINITY;
+    }
+    let e = ((key.to_bits() >> 52) & 0x7ff) as i64 - 1023;
+    e.div_euclid(2) as f64
+}
+
 /// Number of heaps: one per (tries, class).
 const HEAPS: usize = (MAX_TRIES as usize + 1) * CLASSES as usize;
 
@@ -62,6 +80,28 @@ impl FaceQueue {
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn size_classes_are_factors_of_four() {
+        assert_eq!(size_class(1.0), 0.0);
+        assert_eq!(size_class(3.99), 0.0);
+        assert_eq!(size_class(4.0), 1.0);
+        assert_eq!(size_class(0.25), -1.0);
+        assert_eq!(size_class(0.2499), -2.0);
+        assert_eq!(size_class(0.0), f64::NEG_INFINITY);
+        assert_eq!(size_class(f64::MIN_POSITIVE / 2.0), f64::NEG_INFINITY);
+        assert_eq!(size_class(f64::INFINITY), f64::INFINITY);
+        assert!(size_class(f64::NAN).is_nan());
+        // Monotone: a smaller key never gets a larger class.
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        for _ in 0..10_000 {
+            let a: f64 = 10f64.powf(rng.random_range(-300.0..300.0));
+            let b: f64 = a * rng.random_range(1.0..10.0);
+            assert!(size_class(a) <= size_class(b), "{a} {b}");
+            let c = size_class(a);
+            assert!(4f64.powf(c) <= a * (1.0 + 1e-12) && a < 4f64.powf(c + 1.0) * (1.0 + 1e-12));
+        }
+    }
 
     #[test]
     fn pops_in_the_order_of_the_tuple() {
