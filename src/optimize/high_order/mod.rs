@@ -2,20 +2,22 @@
 //!
 //! Seeds are the elements whose certified min J / max J is below a threshold, worst
 //! first. Around each a patch is built ([`patch`]); patches are coloured so that those of
-//! one colour share no active element, and the patches of a colour are optimized in
-//! parallel, each by a sequence of L-BFGS runs on the log-barrier objective
-//! ([`objective`]) with the barrier moved up to just below the current minimum after each
-//! run (Gmsh's moving barrier; it starts from any state, including invalid elements).
-//! A patch's result is kept only when the certified minimum min J / max J of its active
-//! elements rose (and, if vertices moved, their skewness stayed within bounds); results
-//! are written back in patch order, so the output does not depend on the thread count.
-//! Surface nodes are never variables.
+//! one colour share no active element, and each patch is optimized once the patches of
+//! lower colours it shares an element with are done ([`schedule`]: in parallel, and the
+//! same result as colour by colour), by a sequence of L-BFGS runs on the log-barrier
+//! objective ([`objective`]) with the barrier moved up to just below the current minimum
+//! after each run (Gmsh's moving barrier; it starts from any state, including invalid
+//! elements). A patch's result is kept only when the certified minimum min J / max J of
+//! its active elements rose (and, if vertices moved, their skewness stayed within
+//! bounds); the output does not depend on the thread count. Surface nodes are never
+//! variables.
 
 mod jacobian;
 mod lanes;
 mod lbfgs;
 mod objective;
 mod patch;
+mod schedule;
 
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
@@ -237,36 +239,12 @@ pub fn optimize_high_order(
             patches.push(p);
         }
         let colours = colour(&patches, ne);
-        let ncol = colours.iter().copied().max().map_or(0, |c| c + 1);
-        let mut improved_round = 0;
-        for c in 0..ncol {
-            let batch: Vec<usize> = (0..patches.len()).filter(|&i| colours[i] == c).collect();
-            if batch.is_empty() {
-                continue;
-            }
-            let nodes_now = &mesh.nodes;
-            let results: Vec<(Option<PatchResult>, u64)> = batch
-                .par_iter()
-                .map(|&i| {
-                    let mut lb = Lbfgs::default();
-                    optimize_patch(mesh, nodes_now, &patches[i], &sj, prm, &mut lb)
-                })
-                .collect();
-            st.patches += batch.len();
-            for (&i, (r, work)) in batch.iter().zip(results) {
-                st.element_evaluations += work;
-                st.patch_elements += patches[i].elems.len() as u64;
-                let Some(r) = r else { continue };
-                st.patches_improved += 1;
-                improved_round += 1;
-                for (n, p) in patches[i].free.iter().zip(r.positions) {
-                    mesh.nodes[*n as usize] = p;
-                }
-                for (e, v) in patches[i].elems.iter().zip(r.sj) {
-                    sj[*e as usize] = v;
-                }
-            }
-        }
+        let done = schedule::run_round(mesh, &patches, &colours, &mut sj, prm);
+        st.patches += patches.len();
+        st.patch_elements += patches.iter().map(|p| p.elems.len() as u64).sum::<u64>();
+        st.element_evaluations += done.work;
+        st.patches_improved += done.improved;
+        let improved_round = done.improved;
         if improved_round == 0 {
             if escalate || prm.vertices_below >= prm.threshold || !prm.move_vertices {
                 break;
@@ -376,28 +354,32 @@ fn evaluate(
     (lo, sk)
 }
 
-/// Optimize one patch against the node positions `x`; `None` when nothing improved.
-///
-/// Stage A moves the free mid nodes only (the straight-sided shape is kept); when that
-/// leaves the patch below the threshold and vertices may move, stage B continues from
-/// A's result with the free vertices too, kept only if their corner skewness stays
-/// within [`HighOrderParams::max_skewness`] ([`HighOrderParams::max_skewness_rescue`]
-/// for a poor patch), or below the patch's previous worst.
-fn optimize_patch(
-    mesh: &TetMesh,
-    x: &[P3],
-    p: &Patch,
-    sj: &[f64],
-    prm: &HighOrderParams,
-    lb: &mut Lbfgs,
-) -> (Option<PatchResult>, u64) {
+/// What a patch starts from, read from the mesh once every patch it depends on is done
+/// (see [`schedule`]).
+struct PatchJob {
+    /// The active elements with their fixed nodes and variables.
+    elems: Vec<PatchElem>,
+    /// Mean edge length (scales the first L-BFGS step).
+    h: f64,
+    /// Smallest score of the active elements before.
+    before_min: f64,
+    /// Their total shortfall below the threshold before.
+    before_def: f64,
+    /// Initial variables.
+    v: Vec<f64>,
+    /// Number of free nodes.
+    n_free: usize,
+}
+
+/// The inputs of patch `p` at node positions `x` and element scores `sj`.
+fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &HighOrderParams) -> PatchJob {
     let var_of = |n: u32| -> u32 { p.free.binary_search(&n).map_or(FIXED, |i| i as u32) };
     let mut elems = Vec::with_capacity(p.elems.len());
     let mut h = 0.0;
     let mut before_min = f64::INFINITY;
     let mut before_def = 0.0;
     for &e in &p.elems {
-        let t = &mesh.tets[e as usize];
+        let t = &tets[e as usize];
         let xe: [P3; 10] = std::array::from_fn(|k| x[t[k] as usize]);
         h += dist(xe[0], xe[1]);
         before_min = before_min.min(sj[e as usize]);
@@ -424,6 +406,32 @@ fn optimize_patch(
             v[i..i + 3].copy_from_slice(&val);
         }
     }
+    PatchJob {
+        elems,
+        h,
+        before_min,
+        before_def,
+        v,
+        n_free: p.free.len(),
+    }
+}
+
+/// Optimize one prepared patch; `None` when nothing improved.
+///
+/// Stage A moves the free mid nodes only (the straight-sided shape is kept); when that
+/// leaves the patch below the threshold and vertices may move, stage B continues from
+/// A's result with the free vertices too, kept only if their corner skewness stays
+/// within [`HighOrderParams::max_skewness`] ([`HighOrderParams::max_skewness_rescue`]
+/// for a poor patch), or below the patch's previous worst.
+fn run_patch(job: PatchJob, prm: &HighOrderParams, lb: &mut Lbfgs) -> (Option<PatchResult>, u64) {
+    let PatchJob {
+        elems,
+        h,
+        before_min,
+        before_def,
+        mut v,
+        n_free,
+    } = job;
     // Stage A: mid nodes only.
     let mids: Vec<PatchElem> = elems
         .iter()
@@ -479,8 +487,8 @@ fn optimize_patch(
         return (None, work);
     };
     // Final free node positions.
-    let mut pos = vec![[0.0; 3]; p.free.len()];
-    let mut done = vec![false; p.free.len()];
+    let mut pos = vec![[0.0; 3]; n_free];
+    let mut done = vec![false; n_free];
     for el in &elems {
         let xe = nodes(el, &v);
         for (&i, &xk) in el.var.iter().zip(xe.iter()) {
