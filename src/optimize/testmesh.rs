@@ -29,6 +29,29 @@ impl CubeMesh {
     pub fn p2(&self) -> TetMesh {
         crate::mesh::build::assemble(&self.pts, &self.tets, self.n_surf, &self.tris, &[])
     }
+
+    /// [`CubeMesh::p2`] with every interior mid node moved by a random offset of up to
+    /// `amp` per coordinate (seeded: the same mesh every time), for the high-order stage
+    /// to work on.
+    pub fn p2_perturbed(&self, seed: u64, amp: f64) -> TetMesh {
+        use rand::{Rng, SeedableRng};
+        let mut m = self.p2();
+        let mut is_vertex = vec![false; m.nodes.len()];
+        for t in &m.tets {
+            for &v in &t[..4] {
+                is_vertex[v as usize] = true;
+            }
+        }
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        for (x, &v) in m.nodes.iter_mut().zip(&is_vertex).skip(self.n_surf) {
+            if !v {
+                for c in x.iter_mut() {
+                    *c += rng.random_range(-amp..amp);
+                }
+            }
+        }
+        m
+    }
 }
 
 /// The unit cube in `k^3` cells, each split into six tets around its main diagonal.

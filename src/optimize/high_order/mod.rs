@@ -519,7 +519,6 @@ mod tests {
     use super::*;
     use crate::mesh::quality::uncertified;
     use crate::optimize::testmesh::cube;
-    use rand::{Rng, SeedableRng};
 
     /// A free (interior, non-corner) mid node of `m` near the cube's centre.
     fn central_mid(m: &TetMesh, n_surf: usize) -> u32 {
@@ -563,16 +562,7 @@ mod tests {
     fn same_result_for_one_two_and_four_threads() {
         let c = cube(4, 0.08);
         let bnd = c.boundary();
-        let mut base = c.p2();
-        let adj = NodeElems::new(&base);
-        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-        for n in c.n_surf..base.nodes.len() {
-            if !adj.is_vertex[n] {
-                for d in 0..3 {
-                    base.nodes[n][d] += rng.random_range(-0.04..0.04);
-                }
-            }
-        }
+        let base = c.p2_perturbed(7, 0.04);
         let mut out: Vec<(Vec<P3>, String)> = Vec::new();
         for threads in [1, 2, 4] {
             let pool = rayon::ThreadPoolBuilder::new()
