@@ -3,7 +3,8 @@
 # the tube (alternate rings shifted by half a step) as OFF:
 #     scripts/aniso-torus.py NU NV OUT.off
 # Few NU for many NV gives anisotropic triangles: 50 x 54 (aspect ratio 2.0 median) is
-# the input on which the front stalls (README status); 60 x 54 (1.7) meshes in a second.
+# the input on which the front needs its fourth configuration and a minute (README
+# status); 60 x 54 (1.7) meshes in a second.
 import math, sys
 nu, nv, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 R, r = 1.0, 0.35
