@@ -76,9 +76,6 @@ struct Face {
     btri: u32,
     /// Version: queue entries with an older version are stale.
     ver: u32,
-    /// Current queue class (0: thin wedge, 1: by size) and key.
-    qclass: u8,
-    qkey: f64,
     /// A lower bound of the distance from the face's centroid to the nearest surface
     /// vertex (0: unknown), for [`SizeField::at_near`].
     dnear: f64,
@@ -244,8 +241,6 @@ impl<'a> Mesher<'a> {
             tries: 0,
             btri,
             ver: 0,
-            qclass: 1,
-            qkey: 0.0,
             dnear: 0.0,
         });
         for k in 0..3 {
@@ -266,12 +261,13 @@ impl<'a> Mesher<'a> {
             }
         }
         self.enqueue(id);
-        // A neighbour now in a thinner wedge moves up the queue.
+        // A neighbour in a thin wedge with the new face is queued again, under its
+        // thinnest wedge now. (Every such neighbour: whether it already sat in the
+        // thin-wedge class with a thinner key is not tracked, and skipping those would
+        // change the order the faces are taken in.)
         for k in 0..3 {
             if let Some(&g) = self.edges.get(&(v[(k + 1) % 3], v[k])) {
-                let w = self.wedge_deg(g, id);
-                let gf = self.faces[g as usize];
-                if w < WEDGE_FIRST_DEG && (gf.qclass != 0 || w < gf.qkey) {
+                if self.wedge_deg(g, id) < WEDGE_FIRST_DEG {
                     self.faces[g as usize].ver += 1;
                     self.enqueue(g);
                 }

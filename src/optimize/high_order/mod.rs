@@ -244,8 +244,7 @@ pub fn optimize_high_order(
         st.patch_elements += patches.iter().map(|p| p.elems.len() as u64).sum::<u64>();
         st.element_evaluations += done.work;
         st.patches_improved += done.improved;
-        let improved_round = done.improved;
-        if improved_round == 0 {
+        if done.improved == 0 {
             if escalate || prm.vertices_below >= prm.threshold || !prm.move_vertices {
                 break;
             }
