@@ -132,37 +132,30 @@ pub(super) fn coefficients<T: Lane>(y: &[V3<T>; 10]) -> ([T; 20], [[V3<T>; 4]; 3
 /// ∂F/∂x_n for the ten nodes from `gs[s]` = w_s ∂F/∂b_s and the columns `c`.
 #[inline(always)]
 pub(super) fn node_gradient<T: Lane>(c: &[[V3<T>; 4]; 3], gs: &[T; 20]) -> [V3<T>; 10] {
-    // W_ijk = gs[slot(i, j, k)] is symmetric in (i, j, k). With U = Σ_k W_ijk c_2[k]:
-    // ∂F/∂c_0[i] = Σ_j c_1[j] × U_ij, and cyclically for c_1 and c_2 (register-friendly
-    // two-step contractions instead of 64 accumulations into memory).
+    // Reverse mode through the forward pass: b_s = w_s Σ c_0[i] · X_jk with
+    // X_jk = c_1[j] × c_2[k]. With W_ijk = gs[slot(i, j, k)]:
+    // ∂F/∂c_0[i] = Σ_jk W_ijk X_jk, ∂F/∂X_jk = Σ_i W_ijk c_0[i] =: Y_jk, and through the
+    // cross product ∂F/∂c_1[j] = Σ_k c_2[k] × Y_jk, ∂F/∂c_2[k] = Σ_j Y_jk × c_1[j]
+    // (a third fewer operations than contracting each column's weights separately).
     let mut g = [[[T::default(); 3]; 4]; 3];
-    for i in 0..4 {
-        let (mut a0, mut a1, mut a2) = ([T::default(); 3], [T::default(); 3], [T::default(); 3]);
-        for j in 0..4 {
-            let (mut u0, mut u1, mut u2) =
-                ([T::default(); 3], [T::default(); 3], [T::default(); 3]);
-            for k in 0..4 {
-                // Slot (i, j, k) for c_0; (j, i, k) ~ (i, j, k) by symmetry, so the same
-                // weights serve the other two contractions with roles rotated.
+    for j in 0..4 {
+        for k in 0..4 {
+            let x = cross(c[1][j], c[2][k]);
+            let mut y = [T::default(); 3];
+            for i in 0..4 {
                 let wt = gs[TRIPLE_SLOT[16 * i + 4 * j + k] as usize];
                 for d in 0..3 {
-                    u0[d] += wt * c[2][k][d];
-                    u1[d] += wt * c[0][k][d];
-                    u2[d] += wt * c[1][k][d];
+                    g[0][i][d] += wt * x[d];
+                    y[d] += wt * c[0][i][d];
                 }
             }
-            let x0 = cross(c[1][j], u0); // contributes to ∂/∂c_0[i]
-            let x1 = cross(c[2][j], u1); // ∂/∂c_1[i]: Σ_{j,k} W c_2[j] × c_0[k]
-            let x2 = cross(c[0][j], u2); // ∂/∂c_2[i]: Σ_{j,k} W c_0[j] × c_1[k]
+            let a = cross(c[2][k], y);
+            let b = cross(y, c[1][j]);
             for d in 0..3 {
-                a0[d] += x0[d];
-                a1[d] += x1[d];
-                a2[d] += x2[d];
+                g[1][j][d] += a[d];
+                g[2][k][d] += b[d];
             }
         }
-        g[0][i] = a0;
-        g[1][i] = a1;
-        g[2][i] = a2;
     }
     // ∂F/∂x_n = Σ_t UPD[n][t] g[t / 4][t % 4], one call per row so that each unrolls
     // with its zero terms dropped at compile time.
