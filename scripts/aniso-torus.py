@@ -2,9 +2,9 @@
 # Write a linear torus (R = 1, r = 0.35) with NU segments around the axis and NV around
 # the tube (alternate rings shifted by half a step) as OFF:
 #     scripts/aniso-torus.py NU NV OUT.off
-# Few NU for many NV gives anisotropic triangles: 50 x 54 (aspect ratio 2.0 median) is
-# the input on which the front needs its fourth configuration and a minute (README
-# status); 60 x 54 (1.7) meshes in a second.
+# Few NU for many NV gives anisotropic triangles: 50 x 54 (aspect ratio 2.0 median) took
+# the front's fourth configuration and a minute with edge sizes, 2.4 s with the area sizes
+# `--size-from auto` picks for it (README); 20-25 x 54 still leave the front stuck.
 import math, sys
 nu, nv, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 R, r = 1.0, 0.35

@@ -1,16 +1,18 @@
 //! The pipeline: size field → advancing front → P2 assembly → optimization → certification
 //! and report. Each stage hands the next a value; nothing reaches back.
 
+use crate::front::size::corner_sizes;
 use crate::front::size::{regular_edge_from_area, SizeField};
 use crate::front::{run_front, FrontStats, RESTARTS};
 use crate::geom::quadrature::tri6_area;
 use crate::geom::shape::TET10_EDGES;
+use crate::geom::vec3::P3;
 use crate::mesh::quality::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::optimize::{
     improve_linear, optimize_high_order, Boundary, HighOrderParams, LinearParams, OptimizeStats,
 };
-use crate::options::{Options, SizeMode};
+use crate::options::{Options, SizeFrom, SizeMode};
 use crate::{Error, Result, Surface};
 use std::time::Instant;
 
@@ -44,6 +46,8 @@ pub struct Generated {
     pub times: StageTimes,
     /// What the optimization stages did (all zero when `Options::optimize` is off).
     pub optimize: OptimizeStats,
+    /// What the graded size field measured local sizes from (`None` when uniform).
+    pub size_from: Option<SizeFrom>,
     /// Target edge length used where the size is uniform (paper eq. 1 or the user's),
     /// or the smallest boundary size when graded.
     pub size: f64,
@@ -66,14 +70,20 @@ pub fn size_field(surface: &Surface, opts: &Options) -> SizeField {
         SizeMode::Graded => {
             let nodes = surface.nodes();
             let corners = surface.corner_nodes();
-            let pts = corners.iter().map(|&c| nodes[c as usize]).collect();
+            let pts: Vec<P3> = corners.iter().map(|&c| nodes[c as usize]).collect();
             let local = |v: u32| corners.binary_search(&v).map(|i| i as u32).unwrap_or(0);
             let edges: Vec<[u32; 2]> = surface
                 .edges()
                 .iter()
                 .map(|e| [local(e.nodes[0]), local(e.nodes[1])])
                 .collect();
-            SizeField::graded(pts, &edges, opts.gradation)
+            let tris: Vec<[u32; 3]> = surface
+                .triangles()
+                .iter()
+                .map(|t| [local(t[0]), local(t[1]), local(t[2])])
+                .collect();
+            let (h, from) = corner_sizes(&pts, &edges, &tris, opts.size_from);
+            SizeField::graded_from(pts, h, from, &edges, opts.gradation)
         }
     }
 }
@@ -220,6 +230,7 @@ fn generate_inner(
         front: front_stats,
         times,
         optimize: ostats,
+        size_from: size.measured_from(),
         size: size_value,
     })
 }

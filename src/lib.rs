@@ -21,5 +21,5 @@ pub mod threads;
 pub use error::{Error, Result, SurfaceDefect};
 pub use generate::{generate, generate_with_progress, Generated};
 pub use mesh::TetMesh;
-pub use options::{Options, SizeMode};
+pub use options::{Options, SizeFrom, SizeMode};
 pub use surface::Surface;

@@ -138,6 +138,56 @@ fn demo_and_mesh_write_files_check_certifies() {
     let r: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
     assert!(r["report"]["num_tets"].as_u64().unwrap() > 1000);
+    // Near-equilateral triangles: auto sizes from edges.
+    assert_eq!(r["size_from"], "edges");
+}
+
+/// `--size-from areas` is taken and reported and changes the mesh; a uniform size has no
+/// `size_from`, and the two do not combine.
+#[test]
+fn size_from_is_an_option_and_in_the_report() {
+    let mesh = |extra: &[&str], name: &str| -> serde_json::Value {
+        let m = tmp(&format!("{name}.msh"));
+        let report = tmp(&format!("{name}.json"));
+        let input = data("screw_p2.msh");
+        let mut args = vec![
+            "mesh",
+            input.to_str().unwrap(),
+            "-o",
+            m.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "-q",
+            "--no-optimize",
+        ];
+        args.extend_from_slice(extra);
+        let out = run(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+    };
+    let edges = mesh(&[], "screw_edges");
+    let areas = mesh(&["--size-from", "areas"], "screw_areas");
+    assert_eq!(edges["size_from"], "edges");
+    assert_eq!(areas["size_from"], "areas");
+    // The screw's area sizes are within a few percent of its edge sizes: another mesh.
+    assert_ne!(areas["report"]["num_tets"], serde_json::Value::Null);
+    assert_ne!(areas["front"]["steps"], edges["front"]["steps"]);
+    let uniform = mesh(&["--uniform-size"], "screw_uniform");
+    assert!(uniform["size_from"].is_null());
+    let out = run(&[
+        "mesh",
+        data("screw_p2.msh").to_str().unwrap(),
+        "-o",
+        tmp("x.msh").to_str().unwrap(),
+        "--uniform-size",
+        "--size-from",
+        "areas",
+    ]);
+    assert_eq!(out.status.code(), Some(2), "clap refuses the combination");
 }
 
 #[test]

@@ -7,7 +7,7 @@ use curvetet::io::{self, MshVersion, WriteOptions};
 use curvetet::mesh::quality::QualityReport;
 use curvetet::mesh::{check, TetMesh};
 use curvetet::surface::curve::{curve_linear_report, CurveOptions, CurveReport};
-use curvetet::{Error, Generated, Options, SizeMode, Surface};
+use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -160,6 +160,12 @@ struct MeshOptions {
     /// The paper's uniform size from the mean curved triangle area (eq. 1).
     #[arg(long, conflicts_with = "size")]
     uniform_size: bool,
+    /// What the graded size measures at each surface vertex: its mean edge length
+    /// (edges), the equilateral edge of its triangles' mean area (areas: smaller on
+    /// elongated triangles, where edge sizes can leave the front stuck), or areas when
+    /// most triangles are elongated, else edges (auto)
+    #[arg(long, value_enum, default_value_t = SizeFromArg::Auto, conflicts_with_all = ["size", "uniform_size"])]
+    size_from: SizeFromArg,
     /// Skip quality improvement and high-order optimization.
     #[arg(long)]
     no_optimize: bool,
@@ -180,6 +186,14 @@ struct MeshOptions {
     quiet: bool,
     #[command(flatten)]
     write: WriteArgs,
+}
+
+/// [`SizeFrom`] on the command line.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum SizeFromArg {
+    Auto,
+    Edges,
+    Areas,
 }
 
 #[derive(Args)]
@@ -214,6 +228,11 @@ impl MeshOptions {
                 (Some(h), _) => SizeMode::Fixed(h),
                 (None, true) => SizeMode::Uniform,
                 (None, false) => SizeMode::Graded,
+            },
+            size_from: match self.size_from {
+                SizeFromArg::Auto => SizeFrom::Auto,
+                SizeFromArg::Edges => SizeFrom::Edges,
+                SizeFromArg::Areas => SizeFrom::Areas,
             },
             optimize: !self.no_optimize,
             threads: self.threads,
@@ -347,6 +366,7 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
             "times": g.times,
             "optimize": g.optimize,
             "size": g.size,
+            "size_from": g.size_from,
         });
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| Error::InvalidArgument(e.to_string()))?;

@@ -1,8 +1,9 @@
 //! The target size field: target edge length at any point.
 //!
 //! Uniform (the paper's, eq. 1) or graded from the boundary: each surface vertex gets
-//! the mean length of its edges, limited along the surface so neighbours differ by at
-//! most the gradation rate, and the field at a point x is
+//! a local size ([`corner_sizes`]: the mean length of its edges, or on a surface of
+//! elongated triangles the edge of the equilateral triangle of their mean area), limited
+//! along the surface so neighbours differ by at most the gradation rate, and the field at a point x is
 //! `min_i (h_i + g |x - x_i|)` over the nearest surface vertices, capped at the largest
 //! boundary size. So the interior never gets coarser than the coarsest boundary triangle
 //! and sizes change by at most a factor (1 + g) per element.
@@ -14,11 +15,14 @@
 //! vertex is 1-Lipschitz) and skips the k-nearest query there, with the same value bit
 //! for bit.
 
-use crate::geom::vec3::{dist, P3};
+use crate::geom::vec3::{dist, norm, tri_normal, P3};
+use crate::options::SizeFrom;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
 
 /// Target edge length as a function of position.
+// One per run: the size of the graded variant does not matter.
+#[allow(clippy::large_enum_variant)]
 pub enum SizeField {
     /// The same edge length everywhere.
     Uniform(f64),
@@ -36,7 +40,90 @@ pub enum SizeField {
         tree: ImmutableKdTree<f64, 3>,
         /// Smallest of `h`.
         hmin: f64,
+        /// What the local sizes were measured from ([`SizeFrom::Edges`] or
+        /// [`SizeFrom::Areas`]).
+        from: SizeFrom,
     },
+}
+
+/// [`SizeFrom::Auto`] measures sizes from areas when the median over the surface
+/// vertices of (area size / edge size) is below this. It is 1 on equilateral triangles;
+/// 0.99-1.00 on the six benchmark surfaces; 0.76-0.83 on the anisotropic tori
+/// (`scripts/aniso-torus.py` 40-50 x 54) that leave the front stuck with edge sizes and
+/// mesh at once with area sizes; 0.85-0.88 on tori that mesh either way.
+pub const AREAS_BELOW: f64 = 0.9;
+
+/// The local size at each surface corner `pts[i]` given the corner edges and triangles,
+/// measured as `from` says, and what it was measured from (`Auto` resolved). A corner on
+/// no edge gets +∞ (no size).
+pub fn corner_sizes(
+    pts: &[P3],
+    edges: &[[u32; 2]],
+    tris: &[[u32; 3]],
+    from: SizeFrom,
+) -> (Vec<f64>, SizeFrom) {
+    let n = pts.len();
+    let mean = |sum: &[f64], cnt: &[u32]| -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                if cnt[i] > 0 {
+                    sum[i] / cnt[i] as f64
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect()
+    };
+    let (mut sum, mut cnt) = (vec![0.0f64; n], vec![0u32; n]);
+    for &[a, b] in edges {
+        let l = dist(pts[a as usize], pts[b as usize]);
+        for v in [a, b] {
+            sum[v as usize] += l;
+            cnt[v as usize] += 1;
+        }
+    }
+    let by_edges = mean(&sum, &cnt);
+    if from == SizeFrom::Edges {
+        return (by_edges, SizeFrom::Edges);
+    }
+    let (mut sum, mut cnt) = (vec![0.0f64; n], vec![0u32; n]);
+    for t in tris {
+        let p = t.map(|v| pts[v as usize]);
+        let area = 0.5 * norm(tri_normal(p[0], p[1], p[2]));
+        for &v in t {
+            sum[v as usize] += area;
+            cnt[v as usize] += 1;
+        }
+    }
+    let by_areas: Vec<f64> = mean(&sum, &cnt)
+        .into_iter()
+        .map(|a| {
+            if a.is_finite() {
+                regular_edge_from_area(a)
+            } else {
+                a
+            }
+        })
+        .collect();
+    if from == SizeFrom::Areas {
+        return (by_areas, SizeFrom::Areas);
+    }
+    let mut ratios: Vec<f64> = by_areas
+        .iter()
+        .zip(&by_edges)
+        .filter(|(a, e)| a.is_finite() && e.is_finite() && **e > 0.0)
+        .map(|(a, e)| a / e)
+        .collect();
+    if ratios.is_empty() {
+        return (by_edges, SizeFrom::Edges);
+    }
+    let mid = ratios.len() / 2;
+    let (_, median, _) = ratios.select_nth_unstable_by(mid, f64::total_cmp);
+    if *median < AREAS_BELOW {
+        (by_areas, SizeFrom::Areas)
+    } else {
+        (by_edges, SizeFrom::Edges)
+    }
 }
 
 /// Edge length of the regular tetrahedron whose faces have area `a`.
@@ -50,27 +137,23 @@ pub fn regular_height(l: f64) -> f64 {
 }
 
 impl SizeField {
-    /// The graded field of a surface given by its corner positions and corner edges.
+    /// The graded field of a surface given by its corner positions and corner edges, the
+    /// local sizes measured from edges.
     pub fn graded(corner_pts: Vec<P3>, edges: &[[u32; 2]], g: f64) -> SizeField {
+        let (h, from) = corner_sizes(&corner_pts, edges, &[], SizeFrom::Edges);
+        SizeField::graded_from(corner_pts, h, from, edges, g)
+    }
+
+    /// The graded field of local sizes `h` at the corners `corner_pts` (measured from
+    /// `from`; +∞ where none), limited along the corner edges by the growth rate `g`.
+    pub fn graded_from(
+        corner_pts: Vec<P3>,
+        mut h: Vec<f64>,
+        from: SizeFrom,
+        edges: &[[u32; 2]],
+        g: f64,
+    ) -> SizeField {
         let n = corner_pts.len();
-        let mut sum = vec![0.0f64; n];
-        let mut cnt = vec![0u32; n];
-        for &[a, b] in edges {
-            let l = dist(corner_pts[a as usize], corner_pts[b as usize]);
-            for v in [a, b] {
-                sum[v as usize] += l;
-                cnt[v as usize] += 1;
-            }
-        }
-        let mut h: Vec<f64> = (0..n)
-            .map(|i| {
-                if cnt[i] > 0 {
-                    sum[i] / cnt[i] as f64
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .collect();
         // Gradation limit along the surface: relax h_j <= h_i + g |x_i - x_j| over edges
         // until nothing changes (a few sweeps; each sweep is O(edges)). Bounded.
         for _ in 0..64 {
@@ -108,6 +191,15 @@ impl SizeField {
             hmax,
             tree,
             hmin,
+            from,
+        }
+    }
+
+    /// What the local sizes of a graded field were measured from (`None` when uniform).
+    pub fn measured_from(&self) -> Option<SizeFrom> {
+        match self {
+            SizeField::Uniform(_) => None,
+            SizeField::Graded { from, .. } => Some(*from),
         }
     }
 
@@ -129,6 +221,7 @@ impl SizeField {
                 hmax,
                 tree,
                 hmin,
+                ..
             } => {
                 // Every term of the minimum below is at least hmin + g * (distance to
                 // the nearest vertex), rounding being monotone: when that reaches the
@@ -167,6 +260,47 @@ impl SizeField {
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+
+    /// A strip of `n` quads split into triangles, `w` by `hgt` each: corners, edges and
+    /// triangles.
+    fn strip(n: usize, w: f64, hgt: f64) -> (Vec<P3>, Vec<[u32; 2]>, Vec<[u32; 3]>) {
+        let mut pts = Vec::new();
+        for i in 0..=n {
+            pts.push([i as f64 * w, 0.0, 0.0]);
+            pts.push([i as f64 * w, hgt, 0.0]);
+        }
+        let (mut edges, mut tris) = (Vec::new(), Vec::new());
+        for i in 0..n as u32 {
+            let (a, b, c, d) = (2 * i, 2 * i + 2, 2 * i + 3, 2 * i + 1);
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+            edges.extend([[a, b], [b, c], [c, a], [c, d], [d, a]]);
+        }
+        edges.push([0, 1]);
+        (pts, edges, tris)
+    }
+
+    #[test]
+    fn auto_sizes_from_areas_only_on_elongated_triangles() {
+        // Near-equilateral triangles (1 x 0.9 halves): edges.
+        let (p, e, t) = strip(20, 1.0, 0.9);
+        let (h, from) = corner_sizes(&p, &e, &t, SizeFrom::Auto);
+        assert_eq!(from, SizeFrom::Edges);
+        assert_eq!(h, corner_sizes(&p, &e, &t, SizeFrom::Edges).0);
+        // Halves of 1 x 0.3 rectangles: areas, and an interior corner's size is the
+        // equilateral edge of its triangles' mean area (every triangle has area 0.15).
+        let (p, e, t) = strip(20, 1.0, 0.3);
+        let (h, from) = corner_sizes(&p, &e, &t, SizeFrom::Auto);
+        assert_eq!(from, SizeFrom::Areas);
+        let want = regular_edge_from_area(0.15);
+        assert!((h[10] - want).abs() < 1e-12 * want, "{} vs {want}", h[10]);
+        let (he, _) = corner_sizes(&p, &e, &t, SizeFrom::Edges);
+        assert!(h[10] < 0.9 * he[10], "areas {} edges {}", h[10], he[10]);
+        // Forced either way.
+        assert_eq!(corner_sizes(&p, &e, &t, SizeFrom::Edges).1, SizeFrom::Edges);
+        let (p, e, t) = strip(20, 1.0, 0.9);
+        assert_eq!(corner_sizes(&p, &e, &t, SizeFrom::Areas).1, SizeFrom::Areas);
+    }
 
     /// A graded field on random points of the unit sphere.
     fn sphere_field(rng: &mut rand::rngs::StdRng) -> (SizeField, Vec<P3>) {
