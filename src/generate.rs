@@ -136,7 +136,8 @@ fn generate_inner(
             &size,
             first,
             progress,
-        )?;
+        )
+        .map_err(|e| with_shape_hint(e, surface))?;
         times.front += t.elapsed().as_secs_f64();
 
         let mut ostats = OptimizeStats::default();
@@ -235,6 +236,54 @@ fn generate_inner(
     })
 }
 
+/// Boundary triangles with a larger aspect ratio than this are named in the message of a
+/// front that could not close (the hinge, which meshes, has two just above 10; raw
+/// marching-cubes surfaces, which do not, have hundreds up to 50-1,000).
+pub const POOR_ASPECT_RATIO: f64 = 10.0;
+
+/// Aspect ratio of the corner triangle `t` of `s`: longest edge × perimeter / (4√3 area),
+/// 1 for the equilateral triangle, +∞ for a degenerate one.
+fn aspect_ratio(s: &Surface, t: &[u32; 6]) -> f64 {
+    use crate::geom::vec3::{dist, norm, tri_normal};
+    let p = |k: usize| s.nodes()[t[k] as usize];
+    let e = [dist(p(0), p(1)), dist(p(1), p(2)), dist(p(2), p(0))];
+    let area = 0.5 * norm(tri_normal(p(0), p(1), p(2)));
+    let r = e[0].max(e[1]).max(e[2]) * (e[0] + e[1] + e[2]) / (4.0 * 3f64.sqrt() * area);
+    if r.is_nan() {
+        f64::INFINITY
+    } else {
+        r
+    }
+}
+
+/// A front failure on a surface with poorly shaped triangles says so, and what helps.
+fn with_shape_hint(e: Error, s: &Surface) -> Error {
+    let Error::MeshingFailed { msg, partial } = e else {
+        return e;
+    };
+    let (mut poor, mut worst) = (0usize, 0.0f64);
+    for t in s.triangles() {
+        let r = aspect_ratio(s, t);
+        if r > POOR_ASPECT_RATIO {
+            poor += 1;
+        }
+        worst = worst.max(r);
+    }
+    if poor == 0 {
+        return Error::MeshingFailed { msg, partial };
+    }
+    Error::MeshingFailed {
+        msg: format!(
+            "{msg}. Note: {poor} of {} boundary triangles are poorly shaped (aspect ratio above \
+             {POOR_ASPECT_RATIO}, worst {worst:.0}); the front needs well-shaped boundary \
+             triangles: smooth a surface from image segmentation before curving (CLI \
+             `--smooth 10`, `CurveOptions::smooth_iterations`) or remesh it",
+            s.triangles().len()
+        ),
+        partial,
+    }
+}
+
 /// The environment variable that makes [`generate`] corrupt its own mesh just before the
 /// final check, to prove the check catches it (`Error::InvalidMesh`, C status
 /// `CURVETET_ERR_INVALID_MESH`, CLI exit 6): `invert[:T]` swaps two corners of tet `T`
@@ -311,4 +360,42 @@ pub fn estimated_peak_memory(surface: &Surface, opts: &Options) -> u64 {
     (tets as u64)
         .saturating_mul(BYTES_PER_TET)
         .saturating_add((tris as u64).saturating_mul(BYTES_PER_TRIANGLE))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::curve::CurveOptions;
+
+    fn mc_blob(smooth_iterations: u32) -> Surface {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mc_blob.off");
+        let opts = CurveOptions {
+            smooth_iterations,
+            ..CurveOptions::default()
+        };
+        crate::io::read_any_surface(&path, &opts).expect("curves")
+    }
+
+    #[test]
+    fn a_stuck_front_on_poor_triangles_says_what_helps() {
+        let failed = || Error::MeshingFailed {
+            msg: "stuck".into(),
+            partial: None,
+        };
+        let Error::MeshingFailed { msg, .. } = with_shape_hint(failed(), &mc_blob(0)) else {
+            panic!("not a meshing failure");
+        };
+        assert!(
+            msg.starts_with("stuck. Note: 101 of 2316 boundary triangles"),
+            "{msg}"
+        );
+        assert!(msg.contains("--smooth 10"), "{msg}");
+        // Well-shaped triangles: the message is left alone; other errors too.
+        let Error::MeshingFailed { msg, .. } = with_shape_hint(failed(), &mc_blob(10)) else {
+            panic!("not a meshing failure");
+        };
+        assert_eq!(msg, "stuck");
+        let e = with_shape_hint(Error::Cancelled, &mc_blob(0));
+        assert!(matches!(e, Error::Cancelled));
+    }
 }

@@ -141,11 +141,20 @@ struct CurveArgs {
     /// angle (degrees) are sharp features, kept sharp and followed by the curving.
     #[arg(long, default_value_t = 40.0)]
     feature_angle: f64,
+    /// For a linear input surface: Taubin-smooth its vertices with this many iterations
+    /// before curving. For surfaces from image segmentation (marching cubes), whose needle
+    /// and cap triangles leave the front stuck: 10 makes them well shaped. Moves the
+    /// surface (by a fraction of a voxel) and rounds sharp edges
+    #[arg(long, default_value_t = 0)]
+    smooth: u32,
 }
 
 impl CurveArgs {
     fn options(&self) -> CurveOptions {
-        CurveOptions::with_feature_angle(self.feature_angle)
+        CurveOptions {
+            smooth_iterations: self.smooth,
+            ..CurveOptions::with_feature_angle(self.feature_angle)
+        }
     }
 }
 

@@ -44,6 +44,7 @@ mod check;
 mod guard;
 mod midpoint;
 mod sectors;
+mod smooth;
 mod tangents;
 
 pub use guard::GuardCounts;
@@ -105,6 +106,10 @@ pub struct CurveOptions {
     pub rule: MidpointRule,
     /// How vertex normals are averaged. Default [`NormalWeights::Max`].
     pub normals: NormalWeights,
+    /// Taubin smoothing iterations (λ 0.5, μ −0.53, uniform weights) on the vertices
+    /// before curving; default 0: the vertices are kept. For surfaces from image segmentation, whose
+    /// needle and cap triangles leave the front stuck; moves the surface.
+    pub smooth_iterations: u32,
 }
 
 impl Default for CurveOptions {
@@ -114,6 +119,7 @@ impl Default for CurveOptions {
             min_normal_cosine: 0.25,
             rule: MidpointRule::Arc,
             normals: NormalWeights::Max,
+            smooth_iterations: 0,
         }
     }
 }
@@ -192,6 +198,21 @@ pub fn curve_linear_report(
             tri3.len()
         )));
     }
+    let nodes = if opts.smooth_iterations > 0 {
+        // Smooth the checked surface, then check the smoothed one (it must still be a
+        // valid surface: no fold, no self-intersection).
+        let check::Lifted {
+            mut nodes,
+            edges,
+            n_input,
+            ..
+        } = check::check_linear(nodes, &tri3)?;
+        smooth::taubin(&mut nodes, n_input, &edges, opts.smooth_iterations);
+        nodes.truncate(n_input);
+        nodes
+    } else {
+        nodes
+    };
     let lifted = check::check_linear(nodes, &tri3)?;
     let check::Lifted {
         mut nodes,
