@@ -243,19 +243,6 @@ pub fn optimize_high_order(
         st.patches += patches.len();
         st.patch_elements += patches.iter().map(|p| p.elems.len() as u64).sum::<u64>();
         st.element_evaluations += done.work;
-        if std::env::var_os("CT_DBG").is_some() {
-            let w = sj.iter().copied().fold(f64::INFINITY, f64::min);
-            let below = sj.iter().filter(|&&v| v < 0.85).count();
-            eprintln!(
-                "round {round} thr {:.3} patches {} improved {} work {} min {:.4} below {}",
-                prm.threshold,
-                patches.len(),
-                done.improved,
-                done.work,
-                w,
-                below
-            );
-        }
         st.patches_improved += done.improved;
         if done.improved == 0 {
             if escalate || prm.vertices_below >= prm.threshold || !prm.move_vertices {
