@@ -142,32 +142,39 @@ fn demo_and_mesh_write_files_check_certifies() {
     assert_eq!(r["size_from"], "edges");
 }
 
+/// `curvetet mesh INPUT -o NAME.msh --report NAME.json -q EXTRA...`, which must succeed;
+/// the report.
+fn mesh_report(input: &Path, name: &str, extra: &[&str]) -> serde_json::Value {
+    let m = tmp(&format!("{name}.msh"));
+    let report = tmp(&format!("{name}.json"));
+    let mut args = vec![
+        "mesh",
+        input.to_str().unwrap(),
+        "-o",
+        m.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "-q",
+    ];
+    args.extend_from_slice(extra);
+    let out = run(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+}
+
 /// `--size-from areas` is taken and reported and changes the mesh; a uniform size has no
 /// `size_from`, and the two do not combine.
 #[test]
 fn size_from_is_an_option_and_in_the_report() {
-    let mesh = |extra: &[&str], name: &str| -> serde_json::Value {
-        let m = tmp(&format!("{name}.msh"));
-        let report = tmp(&format!("{name}.json"));
-        let input = data("screw_p2.msh");
-        let mut args = vec![
-            "mesh",
-            input.to_str().unwrap(),
-            "-o",
-            m.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-            "-q",
-            "--no-optimize",
-        ];
+    let screw = data("screw_p2.msh");
+    let mesh = |extra: &[&str], name: &str| {
+        let mut args = vec!["--no-optimize"];
         args.extend_from_slice(extra);
-        let out = run(&args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+        mesh_report(&screw, name, &args)
     };
     let edges = mesh(&[], "screw_edges");
     let areas = mesh(&["--size-from", "areas"], "screw_areas");
@@ -224,27 +231,7 @@ fn bad_options_and_missing_files_fail_clearly() {
 #[test]
 fn mesh_plots_the_two_histograms_and_optimization_can_be_turned_off() {
     let s = data("sphere_p2.msh");
-    let mesh_with = |name: &str, extra: &[&str]| -> serde_json::Value {
-        let o = tmp(&format!("{name}.msh"));
-        let report = tmp(&format!("{name}.json"));
-        let mut args = vec![
-            "mesh",
-            s.to_str().unwrap(),
-            "-o",
-            o.to_str().unwrap(),
-            "--report",
-            report.to_str().unwrap(),
-            "-q",
-        ];
-        args.extend_from_slice(extra);
-        let out = run(&args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
-    };
+    let mesh_with = |name: &str, extra: &[&str]| mesh_report(&s, name, extra);
     let svg = tmp("quality.svg");
     let opt = mesh_with("opt", &["--plot", svg.to_str().unwrap()]);
     let text = std::fs::read_to_string(&svg).unwrap();

@@ -130,19 +130,38 @@ fn bad_options_are_clear_errors() {
 #[test]
 fn large_torus_queued_by_size_class() {
     let (nu, nv) = curvetet::surface::demo::torus_resolution(9000, 1.0, 0.35);
+    let (s, _) = mesh_checked(demo_torus(nu, nv), 0.84, 0.62);
+    assert!(s.triangles().len() >= curvetet::front::SIZE_CLASS_MIN_TRIANGLES);
+}
+
+/// The demo P2 torus (R 1, r 0.35) of `nu` x `nv` segments.
+fn demo_torus(nu: usize, nv: usize) -> curvetet::Surface {
     let (nodes, tris) = curvetet::surface::demo::torus(nu, nv, 1.0, 0.35);
-    assert!(tris.len() >= curvetet::front::SIZE_CLASS_MIN_TRIANGLES);
     let n = tris.len();
-    let s = curvetet::Surface::new(nodes, tris, vec![1; n]).expect("the demo torus is valid");
+    curvetet::Surface::new(nodes, tris, vec![1; n]).expect("the demo torus is valid")
+}
+
+/// `s` meshed with the default options, checked independently, its certified
+/// min J / max J at least `min_sj` and its skewness at most `max_skew`.
+fn mesh_checked(
+    s: curvetet::Surface,
+    min_sj: f64,
+    max_skew: f64,
+) -> (curvetet::Surface, curvetet::Generated) {
     let g = generate(&s, &Options::default()).expect("meshes");
     check_mesh(&s, &g.mesh);
     let q = &g.report.quality;
     assert!(
-        q.scaled_jacobian_certified.min >= 0.84,
+        q.scaled_jacobian_certified.min >= min_sj,
         "certified min J / max J {}",
         q.scaled_jacobian_certified.min
     );
-    assert!(q.skewness.max <= 0.62, "max skewness {}", q.skewness.max);
+    assert!(
+        q.skewness.max <= max_skew,
+        "max skewness {}",
+        q.skewness.max
+    );
+    (s, g)
 }
 
 /// A torus of elongated triangles (50 x 54 segments: aspect ratio about 2, the median
@@ -153,42 +172,22 @@ fn large_torus_queued_by_size_class() {
 /// certified.
 #[test]
 fn elongated_triangles_sized_from_areas() {
-    let (nodes, tris) = curvetet::surface::demo::torus(50, 54, 1.0, 0.35);
-    let n = tris.len();
-    let s = curvetet::Surface::new(nodes, tris, vec![1; n]).expect("the demo torus is valid");
-    let g = generate(&s, &Options::default()).expect("meshes");
+    let (_, g) = mesh_checked(demo_torus(50, 54), 0.75, 0.85);
     assert_eq!(g.size_from, Some(curvetet::SizeFrom::Areas));
     assert_eq!(g.front.restarts, 0, "front stats {:?}", g.front);
-    check_mesh(&s, &g.mesh);
-    let q = &g.report.quality;
-    assert!(
-        q.scaled_jacobian_certified.min >= 0.75,
-        "certified min J / max J {}",
-        q.scaled_jacobian_certified.min
-    );
-    assert!(q.skewness.max <= 0.85, "max skewness {}", q.skewness.max);
 }
 
 /// Largest aspect ratio (longest edge × perimeter / (4√3 area); 1 for equilateral) of the
 /// surface's corner triangles.
 fn worst_aspect(s: &curvetet::Surface) -> f64 {
+    use curvetet::geom::vec3::{dist, norm, tri_normal};
     let p = |i: u32| s.nodes()[i as usize];
     s.triangles()
         .iter()
         .map(|t| {
             let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-            let d = |x: [f64; 3], y: [f64; 3]| {
-                ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt()
-            };
-            let (ab, bc, ca) = (d(a, b), d(b, c), d(c, a));
-            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            let area = 0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+            let (ab, bc, ca) = (dist(a, b), dist(b, c), dist(c, a));
+            let area = 0.5 * norm(tri_normal(a, b, c));
             ab.max(bc).max(ca) * (ab + bc + ca) / (4.0 * 3f64.sqrt() * area)
         })
         .fold(0.0, f64::max)
@@ -219,14 +218,6 @@ fn marching_cubes_surface_smoothed_then_meshed() {
     );
     let (v0, v1) = (rough.volume(), smooth.volume());
     assert!((v1 - v0).abs() < 0.01 * v0, "volume {v0} -> {v1}");
-    let g = generate(&smooth, &Options::default()).expect("the smoothed surface meshes");
-    check_mesh(&smooth, &g.mesh);
+    let (_, g) = mesh_checked(smooth, 0.8, 0.7);
     assert_eq!(g.front.restarts, 0, "front stats {:?}", g.front);
-    let q = &g.report.quality;
-    assert!(
-        q.scaled_jacobian_certified.min >= 0.8,
-        "certified min J / max J {}",
-        q.scaled_jacobian_certified.min
-    );
-    assert!(q.skewness.max <= 0.7, "max skewness {}", q.skewness.max);
 }
