@@ -513,6 +513,27 @@ enum curvetet_status curvetet_surface_from_linear(const double *xyz,
                                                   struct curvetet_surface **out);
 
 /**
+ * [`curvetet_surface_from_linear`] after `smooth_iterations` Taubin smoothing
+ * iterations of the vertices (λ 0.5, μ −0.53, uniform weights; 0: none, the same as
+ * `curvetet_surface_from_linear`). For surfaces from image segmentation (marching
+ * cubes), whose needle and cap triangles leave the front stuck: 10 iterations make them
+ * well shaped. The vertices keep their indices but move (by a fraction of a voxel), and
+ * sharp edges are rounded: not for CAD surfaces. Statuses as
+ * `curvetet_surface_from_linear`; the smoothed surface is checked again.
+ *
+ * # Safety
+ * As `curvetet_surface_from_linear`.
+ */
+enum curvetet_status curvetet_surface_from_linear_smoothed(const double *xyz,
+                                                           size_t num_nodes,
+                                                           const uint32_t *tri3,
+                                                           size_t num_triangles,
+                                                           const int32_t *tags,
+                                                           double feature_angle_deg,
+                                                           uint32_t smooth_iterations,
+                                                           struct curvetet_surface **out);
+
+/**
  * Read a surface from a file, by extension: a P2 surface from Gmsh `.msh` (2.2/4.1,
  * ASCII/binary), VTK `.vtu`/`.vtk` or medit `.mesh`; or a linear one from `.stl`,
  * `.off`, `.obj`, `.ply` (or 3-node triangles in the formats above), which is curved as

@@ -277,7 +277,8 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
             "{msg}. Note: {poor} of {} boundary triangles are poorly shaped (aspect ratio above \
              {POOR_ASPECT_RATIO}, worst {worst:.0}); the front needs well-shaped boundary \
              triangles: smooth a surface from image segmentation before curving (CLI \
-             `--smooth 10`, `CurveOptions::smooth_iterations`) or remesh it",
+             `--smooth 10`, `CurveOptions::smooth_iterations`, C \
+             `curvetet_surface_from_linear_smoothed`) or remesh it",
             s.triangles().len()
         ),
         partial,

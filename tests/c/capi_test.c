@@ -571,6 +571,29 @@ static void test_from_linear(void) {
     CHECK(strstr(curvetet_last_error_message(), "not-closed") != NULL);
     CHECK(curvetet_surface_from_linear(NULL, 6, tri, 8, NULL, 40.0, &s) ==
           CURVETET_ERR_INVALID_ARGUMENT);
+    /* Smoothed first: 0 iterations is the plain call; 2 move the vertices (the
+     * octahedron's vertices all have four neighbours: it shrinks and inflates uniformly),
+     * the result is still a valid surface that meshes. */
+    s = NULL;
+    CHECK(curvetet_surface_from_linear_smoothed(xyz, 6, tri, 8, NULL, 40.0, 0, &s) ==
+          CURVETET_OK);
+    CHECK(s && memcmp(curvetet_surface_nodes(s), xyz, sizeof xyz) == 0);
+    curvetet_surface_free(s);
+    s = NULL;
+    CHECK(curvetet_surface_from_linear_smoothed(xyz, 6, tri, 8, NULL, 40.0, 2, &s) ==
+          CURVETET_OK);
+    if (s) {
+        const double *x = curvetet_surface_nodes(s);
+        CHECK(x[0] != 1.0 && x[0] > 0.5 && x[0] < 1.5 && x[1] == 0.0 && x[2] == 0.0);
+        curvetet_mesh *m2 = NULL;
+        CHECK(curvetet_generate(s, NULL, &m2) == CURVETET_OK);
+        curvetet_mesh_free(m2);
+    }
+    curvetet_surface_free(s);
+    s = NULL;
+    CHECK(curvetet_surface_from_linear_smoothed(xyz, 6, tri, 7, NULL, 40.0, 2, &s) ==
+          CURVETET_ERR_INVALID_SURFACE);
+    CHECK(s == NULL);
 }
 
 static void test_cancel(const curvetet_surface *s, double limit_ms) {
