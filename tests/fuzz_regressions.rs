@@ -86,6 +86,13 @@ fn fuzz_crashes_give_clean_errors() {
             curvetet::io::Format::Msh,
             "node blocks hold more nodes than the header says",
         ),
+        // PLY with two 'vertex' elements (12, then 6): faces were checked against the
+        // first count and indexed the second list out of bounds.
+        (
+            "read_ply/second_vertex_element",
+            curvetet::io::Format::Ply,
+            "a second 'vertex' element",
+        ),
     ];
     for (file, format, words) in cases {
         let data = std::fs::read(dir.join(file)).unwrap();

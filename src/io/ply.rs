@@ -173,6 +173,15 @@ fn header<'a>(c: &mut Cursor<'a>) -> Result<(Encoding, Vec<Element<'a>>)> {
                 let (Some(name), Some(count)) = (w.next(), w.next().and_then(parse_u64)) else {
                     return Err(c.err("expected 'element NAME COUNT'"));
                 };
+                // The reader takes one vertex list and one face list: a second one would
+                // leave the face indices checked against the wrong vertex count.
+                if (name == b"vertex" || name == b"face") && elements.iter().any(|e| e.name == name)
+                {
+                    return Err(c.err(format!(
+                        "a second '{}' element (one is allowed)",
+                        String::from_utf8_lossy(name)
+                    )));
+                }
                 elements.push(Element {
                     name,
                     count,
