@@ -159,6 +159,7 @@ vtkCurveTetFilter::vtkCurveTetFilter()
   , UniformSize(0)
   , Optimize(1)
   , FeatureAngle(40.0)
+  , SmoothIterations(0)
   , NumberOfThreads(0)
   , BoundaryTagArrayName(nullptr)
 {
@@ -243,8 +244,9 @@ int vtkCurveTetFilter::RequestData(
   curvetet_status st = in.nodesPerTriangle == 6
     ? curvetet_surface_from_arrays(
         in.xyz.data(), nn, in.tri.data(), nt, in.tags.data(), &rawSurface)
-    : curvetet_surface_from_linear(
-        in.xyz.data(), nn, in.tri.data(), nt, in.tags.data(), this->FeatureAngle, &rawSurface);
+    : curvetet_surface_from_linear_smoothed(in.xyz.data(), nn, in.tri.data(), nt,
+        in.tags.data(), this->FeatureAngle, static_cast<uint32_t>(this->SmoothIterations),
+        &rawSurface);
   SurfacePtr surface(rawSurface);
   if (st != CURVETET_OK)
   {
@@ -337,6 +339,7 @@ void vtkCurveTetFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "UniformSize: " << this->UniformSize << "\n";
   os << indent << "Optimize: " << this->Optimize << "\n";
   os << indent << "FeatureAngle: " << this->FeatureAngle << "\n";
+  os << indent << "SmoothIterations: " << this->SmoothIterations << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "BoundaryTagArrayName: "
      << (this->BoundaryTagArrayName ? this->BoundaryTagArrayName : "(none)") << "\n";

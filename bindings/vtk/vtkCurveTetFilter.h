@@ -93,6 +93,18 @@ public:
 
   ///@{
   /**
+   * Linear input only: Taubin smoothing iterations of its vertices before curving.
+   * Default 0 (vertices kept). For surfaces from image segmentation (vtkMarchingCubes,
+   * vtkDiscreteFlyingEdges3D), whose needle and cap triangles leave the front stuck: 10
+   * makes them well shaped. Moves the surface (a fraction of a voxel), rounds sharp
+   * edges.
+   */
+  vtkSetClampMacro(SmoothIterations, int, 0, VTK_INT_MAX);
+  vtkGetMacro(SmoothIterations, int);
+  ///@}
+
+  ///@{
+  /**
    * Worker threads of curvetet's parallel stages; 0 (default): all cores. The result does
    * not depend on it.
    */
@@ -132,6 +144,7 @@ protected:
   vtkTypeBool UniformSize;
   vtkTypeBool Optimize;
   double FeatureAngle;
+  int SmoothIterations;
   int NumberOfThreads;
   char* BoundaryTagArrayName;
 

@@ -15,6 +15,8 @@
 //   TestCurveTetFilter abort SURFACE.off
 //       AbortExecute set from a progress observer stops the meshing: empty output, no error;
 //       the next update runs to the end.
+//   TestCurveTetFilter smooth SURFACE.off
+//       a raw marching-cubes surface with SmoothIterations 10: it meshes, its vertices moved.
 #include "vtkCurveTetFilter.h"
 
 #include <curvetet.h>
@@ -695,13 +697,43 @@ void TestAbort(const std::string& off)
   CHECK(filter->GetOutput(0)->GetNumberOfCells() > 0);
   CHECK(!progress.values.empty() && progress.values.back() == 1.0);
 }
+// A raw marching-cubes surface, smoothed by the filter (SmoothIterations 10) before
+// curving: it meshes, and its vertices moved (the output's surface nodes are the
+// smoothed ones).
+void TestSmooth(const std::string& off)
+{
+  vtkSmartPointer<vtkPolyData> in = ReadOff(off);
+  vtkNew<vtkCurveTetFilter> filter;
+  filter->SetInputData(in);
+  filter->SetSmoothIterations(10);
+  CHECK(filter->GetSmoothIterations() == 10);
+  Messages msgs;
+  msgs.Watch(filter);
+  filter->Update();
+  CHECK(msgs.errors == 0);
+  vtkUnstructuredGrid* out = filter->GetOutput(0);
+  CHECK(out->GetNumberOfCells() > 0);
+  CHECK(std::strlen(filter->GetLastErrorMessage()) == 0);
+  vtkIdType moved = 0;
+  for (vtkIdType i = 0; i < in->GetNumberOfPoints(); ++i)
+  {
+    double a[3], b[3];
+    in->GetPoint(i, a);
+    out->GetPoint(i, b);
+    moved += (a[0] != b[0] || a[1] != b[1] || a[2] != b[2]) ? 1 : 0;
+  }
+  CHECK(moved > in->GetNumberOfPoints() / 2);
+  std::printf("  %lld tets, %lld of %lld surface vertices moved by smoothing\n",
+    static_cast<long long>(out->GetNumberOfCells()), static_cast<long long>(moved),
+    static_cast<long long>(in->GetNumberOfPoints()));
+}
 } // namespace
 
 int main(int argc, char* argv[])
 {
   if (argc < 3)
   {
-    std::fprintf(stderr, "usage: %s pipeline|p2|bad|abort FILE [OUTDIR]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s pipeline|p2|bad|abort|smooth FILE [OUTDIR]\n", argv[0]);
     return 2;
   }
   const std::string mode = argv[1], file = argv[2];
@@ -714,6 +746,8 @@ int main(int argc, char* argv[])
     TestBad(file);
   else if (mode == "abort")
     TestAbort(file);
+  else if (mode == "smooth")
+    TestSmooth(file);
   else if (mode == "off2stl" && argc >= 4)
     CHECK(OffToStl(file, argv[3]));
   else
