@@ -54,6 +54,11 @@ use crate::geom::P3;
 
 pub use topology::SurfaceEdge;
 
+/// Surfaces where more than one triangle in this many is poorly shaped
+/// ([`geometry::POOR_ASPECT_RATIO`]) get a warning: 1 % (the hinge has 2 of 1,960; raw
+/// marching-cubes surfaces 4-11 %).
+pub const POOR_SHAPE_WARN_ONE_IN: usize = 100;
+
 /// The warning recorded when an inside-out surface was flipped.
 pub const FLIPPED_WARNING: &str = "orientation was inward; flipped";
 
@@ -131,6 +136,16 @@ impl Surface {
         {
             orientation::flip_all(&mut tris, &mut neighbors, &mut edges);
             warnings.push(FLIPPED_WARNING.to_string());
+        }
+        let (poor, worst) = geometry::poorly_shaped(&nodes, &tris);
+        if poor * POOR_SHAPE_WARN_ONE_IN > tris.len() {
+            warnings.push(format!(
+                "{poor} of {} triangles have an aspect ratio above {} (worst {worst:.0}): the \
+                 advancing front may not close on them; smooth (`--smooth 10`) or remesh a \
+                 surface from image segmentation",
+                tris.len(),
+                geometry::POOR_ASPECT_RATIO
+            ));
         }
         Ok(Surface {
             nodes,
