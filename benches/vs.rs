@@ -17,7 +17,9 @@
 //!   one thread), setOrder(2), write .msh; its time is measured inside the script (merge to
 //!   write, Python start-up excluded), its memory includes the Python interpreter.
 //!
-//! Inputs: every tests/data/NAME_p2.msh (the ../shared/data surfaces) and the built-in
+//! Inputs: every tests/data/NAME_p2.msh (the ../shared/data surfaces), the raw
+//! marching-cubes blob tests/data/mc_blob.off smoothed and curved (`curve --smooth 10`:
+//! an image-derived surface), and the built-in
 //! torus (`curvetet demo --surface-only`) sized for ≈10k/100k/1M curvetet tets.
 //! Ratios are curvetet/tool for wall time, and for time per tet (the tools make different
 //! numbers of tets from the same surface). Timing only; nothing is asserted.
@@ -306,6 +308,25 @@ fn main() {
         {
             inputs.push((name.into(), root.join(format!("tests/data/{name}_p2.msh"))));
         }
+    }
+    // An image-derived surface: the raw marching-cubes blob of tests/data, smoothed and
+    // curved by `curvetet curve --smooth 10` (every tool then meshes that same surface).
+    if args
+        .only
+        .as_ref()
+        .map_or(true, |o| o.iter().any(|x| x == "mc_blob"))
+    {
+        let p = work.join("mc_blob_smoothed_p2.msh");
+        let st = Command::new(exe)
+            .arg("curve")
+            .arg(root.join("tests/data/mc_blob.off"))
+            .args(["--smooth", "10", "-o"])
+            .arg(&p)
+            .stderr(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(st.success(), "curvetet curve --smooth failed");
+        inputs.push(("mc_blob".into(), p));
     }
     for (label, tets) in &args.scales {
         // The demo torus makes ≈ 0.063 · triangles^1.5 tets (measured).
