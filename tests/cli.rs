@@ -58,7 +58,26 @@ fn check_accepts_data_surfaces_with_readme_volumes() {
             (v - v_p2).abs() <= 2e-9 * v_p2.abs().max(1.0),
             "{name}: {v} vs {v_p2}"
         );
+        // Triangle shape: only the hinge has triangles of aspect ratio above 10 (two,
+        // the worst 10.8).
+        let shape = &j["triangle_shape"];
+        let poor = shape["poorly_shaped"].as_u64().unwrap();
+        let worst = shape["worst_aspect_ratio"].as_f64().unwrap();
+        if name == "hinge" {
+            assert!(
+                poor == 2 && (10.7..10.9).contains(&worst),
+                "{name}: {shape}"
+            );
+        } else {
+            assert!(poor == 0 && (1.0..10.0).contains(&worst), "{name}: {shape}");
+        }
     }
+    // A raw marching-cubes surface: many poorly shaped triangles, and the warning.
+    let out = run(&["check", data("mc_blob.off").to_str().unwrap(), "--json"]);
+    assert!(out.status.success());
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["triangle_shape"]["poorly_shaped"], 101);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("aspect ratio above 10"));
 }
 
 #[test]

@@ -554,6 +554,26 @@ fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Er
     Ok(())
 }
 
+/// The corner triangles' shape: how many are poorly shaped for the front, the worst.
+fn shape_json(s: &Surface) -> serde_json::Value {
+    let (poor, worst) = curvetet::surface::geometry::poorly_shaped(s.nodes(), s.triangles());
+    serde_json::json!({
+        "poor_aspect_ratio": curvetet::surface::geometry::POOR_ASPECT_RATIO,
+        "poorly_shaped": poor,
+        "worst_aspect_ratio": worst,
+    })
+}
+
+/// [`shape_json`] as a line of `check`'s text report.
+fn shape_line(s: &Surface) -> String {
+    let (poor, worst) = curvetet::surface::geometry::poorly_shaped(s.nodes(), s.triangles());
+    format!(
+        "triangle aspect ratio: worst {worst:.2}, {poor} of {} above {}",
+        s.triangles().len(),
+        curvetet::surface::geometry::POOR_ASPECT_RATIO
+    )
+}
+
 fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Result<(), Error> {
     let raw = io::read(path)?;
     let name = path.display().to_string();
@@ -568,6 +588,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 "kind": "linear-surface", "file": name, "valid": true,
                 "vertices": s.corner_nodes().len(), "triangles": s.triangles().len(),
                 "shells": s.shell_count(), "enclosed_volume_linear": s.chord_volume(),
+                "triangle_shape": shape_json(&s),
                 "curved": {
                     "edges": r.edges, "feature_edges": r.feature_edges,
                     "curved_edges": r.curved_edges, "flat_edges": r.flat_edges,
@@ -587,6 +608,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 s.shell_count(),
                 s.chord_volume()
             );
+            println!("  {}", shape_line(&s));
             println!(
                 "  curves to a valid P2 surface (feature angle {} deg): {} of {} edges curved, \
                  {} feature edges, {} straightened by the guards; volume {:.12}, min \
@@ -616,6 +638,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 "nodes": s.nodes().len(), "corner_nodes": corners, "triangles": s.triangles().len(),
                 "shells": s.shell_count(), "enclosed_volume": v, "enclosed_volume_linear": vl,
                 "min_normal_cosine": s.min_normal_cosine(), "warnings": s.warnings(),
+                "triangle_shape": shape_json(&s),
             });
             println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
         } else {
@@ -627,6 +650,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 s.shell_count()
             );
             println!("  enclosed volume {v:.12} (linear {vl:.12})");
+            println!("  {}", shape_line(&s));
             println!(
                 "  min cos(curved normal, chord normal) {:.4}",
                 s.min_normal_cosine()
