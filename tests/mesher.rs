@@ -130,8 +130,9 @@ fn bad_options_are_clear_errors() {
 #[test]
 fn large_torus_queued_by_size_class() {
     let (nu, nv) = curvetet::surface::demo::torus_resolution(9000, 1.0, 0.35);
-    let (s, _) = mesh_checked(demo_torus(nu, nv), 0.84, 0.62);
+    let s = demo_torus(nu, nv);
     assert!(s.triangles().len() >= curvetet::front::SIZE_CLASS_MIN_TRIANGLES);
+    mesh_checked(&s, 0.84, 0.62);
 }
 
 /// The demo P2 torus (R 1, r 0.35) of `nu` x `nv` segments.
@@ -143,13 +144,9 @@ fn demo_torus(nu: usize, nv: usize) -> curvetet::Surface {
 
 /// `s` meshed with the default options, checked independently, its certified
 /// min J / max J at least `min_sj` and its skewness at most `max_skew`.
-fn mesh_checked(
-    s: curvetet::Surface,
-    min_sj: f64,
-    max_skew: f64,
-) -> (curvetet::Surface, curvetet::Generated) {
-    let g = generate(&s, &Options::default()).expect("meshes");
-    check_mesh(&s, &g.mesh);
+fn mesh_checked(s: &curvetet::Surface, min_sj: f64, max_skew: f64) -> curvetet::Generated {
+    let g = generate(s, &Options::default()).expect("meshes");
+    check_mesh(s, &g.mesh);
     let q = &g.report.quality;
     assert!(
         q.scaled_jacobian_certified.min >= min_sj,
@@ -161,7 +158,7 @@ fn mesh_checked(
         "max skewness {}",
         q.skewness.max
     );
-    (s, g)
+    g
 }
 
 /// A torus of elongated triangles (50 x 54 segments: aspect ratio about 2, the median
@@ -172,25 +169,14 @@ fn mesh_checked(
 /// certified.
 #[test]
 fn elongated_triangles_sized_from_areas() {
-    let (_, g) = mesh_checked(demo_torus(50, 54), 0.75, 0.85);
+    let g = mesh_checked(&demo_torus(50, 54), 0.75, 0.85);
     assert_eq!(g.size_from, Some(curvetet::SizeFrom::Areas));
     assert_eq!(g.front.restarts, 0, "front stats {:?}", g.front);
 }
 
-/// Largest aspect ratio (longest edge × perimeter / (4√3 area); 1 for equilateral) of the
-/// surface's corner triangles.
+/// Largest aspect ratio of the surface's corner triangles.
 fn worst_aspect(s: &curvetet::Surface) -> f64 {
-    use curvetet::geom::vec3::{dist, norm, tri_normal};
-    let p = |i: u32| s.nodes()[i as usize];
-    s.triangles()
-        .iter()
-        .map(|t| {
-            let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-            let (ab, bc, ca) = (dist(a, b), dist(b, c), dist(c, a));
-            let area = 0.5 * norm(tri_normal(a, b, c));
-            ab.max(bc).max(ca) * (ab + bc + ca) / (4.0 * 3f64.sqrt() * area)
-        })
-        .fold(0.0, f64::max)
+    curvetet::surface::geometry::poorly_shaped(s.nodes(), s.triangles()).1
 }
 
 /// A raw marching-cubes surface (`scripts/marching-cubes.py 22 blob`, 2,316 triangles,
@@ -218,6 +204,6 @@ fn marching_cubes_surface_smoothed_then_meshed() {
     );
     let (v0, v1) = (rough.volume(), smooth.volume());
     assert!((v1 - v0).abs() < 0.01 * v0, "volume {v0} -> {v1}");
-    let (_, g) = mesh_checked(smooth, 0.8, 0.7);
+    let g = mesh_checked(&smooth, 0.8, 0.7);
     assert_eq!(g.front.restarts, 0, "front stats {:?}", g.front);
 }

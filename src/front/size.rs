@@ -3,8 +3,8 @@
 //! Uniform (the paper's, eq. 1) or graded from the boundary: each surface vertex gets
 //! a local size ([`corner_sizes`]: the mean length of its edges, or on a surface of
 //! elongated triangles the edge of the equilateral triangle of their mean area), limited
-//! along the surface so neighbours differ by at most the gradation rate, and the field at a point x is
-//! `min_i (h_i + g |x - x_i|)` over the nearest surface vertices, capped at the largest
+//! along the surface so neighbours differ by at most the gradation rate, and the field
+//! at a point x is `min_i (h_i + g |x - x_i|)` over the nearest surface vertices, capped at the largest
 //! boundary size. So the interior never gets coarser than the coarsest boundary triangle
 //! and sizes change by at most a factor (1 + g) per element.
 //!
@@ -15,7 +15,7 @@
 //! vertex is 1-Lipschitz) and skips the k-nearest query there, with the same value bit
 //! for bit.
 
-use crate::geom::vec3::{dist, norm, tri_normal, P3};
+use crate::geom::vec3::{dist, tri_area, P3};
 use crate::options::SizeFrom;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZero;
@@ -89,7 +89,7 @@ pub fn corner_sizes(
     let (mut sum, mut cnt) = (vec![0.0f64; n], vec![0u32; n]);
     for t in tris {
         let p = t.map(|v| pts[v as usize]);
-        let area = 0.5 * norm(tri_normal(p[0], p[1], p[2]));
+        let area = tri_area(p[0], p[1], p[2]);
         for &v in t {
             sum[v as usize] += area;
             cnt[v as usize] += 1;

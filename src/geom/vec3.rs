@@ -95,6 +95,11 @@ pub fn tet_det(a: P3, b: P3, c: P3, d: P3) -> f64 {
 pub fn tri_normal(a: P3, b: P3, c: P3) -> P3 {
     cross(sub(b, a), sub(c, a))
 }
+/// Area of the triangle (a, b, c).
+#[inline]
+pub fn tri_area(a: P3, b: P3, c: P3) -> f64 {
+    0.5 * norm(tri_normal(a, b, c))
+}
 /// Centroid of a triangle.
 #[inline]
 pub fn centroid3(a: P3, b: P3, c: P3) -> P3 {

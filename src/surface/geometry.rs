@@ -214,9 +214,9 @@ pub const POOR_ASPECT_RATIO: f64 = 10.0;
 /// Aspect ratio of the triangle (a, b, c): longest edge × perimeter / (4√3 area), 1 for
 /// the equilateral triangle, +∞ for a degenerate one.
 pub fn aspect_ratio(a: P3, b: P3, c: P3) -> f64 {
-    use crate::geom::vec3::{dist, norm, tri_normal};
+    use crate::geom::vec3::{dist, tri_area};
     let e = [dist(a, b), dist(b, c), dist(c, a)];
-    let area = 0.5 * norm(tri_normal(a, b, c));
+    let area = tri_area(a, b, c);
     let r = e[0].max(e[1]).max(e[2]) * (e[0] + e[1] + e[2]) / (4.0 * 3f64.sqrt() * area);
     if r.is_nan() {
         f64::INFINITY

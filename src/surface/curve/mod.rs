@@ -107,8 +107,9 @@ pub struct CurveOptions {
     /// How vertex normals are averaged. Default [`NormalWeights::Max`].
     pub normals: NormalWeights,
     /// Taubin smoothing iterations (λ 0.5, μ −0.53, uniform weights) on the vertices
-    /// before curving; default 0: the vertices are kept. For surfaces from image segmentation, whose
-    /// needle and cap triangles leave the front stuck; moves the surface.
+    /// before curving; default 0: the vertices are kept. For surfaces from image
+    /// segmentation, whose needle and cap triangles leave the front stuck; moves the
+    /// surface.
     pub smooth_iterations: u32,
 }
 
