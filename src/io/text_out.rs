@@ -1,7 +1,9 @@
 //! Number output for the text writers, without a `String` per number.
 //!
-//! Floats use Rust's shortest round-trip formatting (`{:?}`: "0.1", "1e-7", "NaN"), so a
-//! reader that rounds correctly (strtod, Rust's parser) gets the exact same `f64` back.
+//! Floats use the shortest round-trip decimal ("0.1", "0.0000001", "1e-300", "NaN") by
+//! zmij, the formatter serde_json uses: `curvetet convert` of the 1M-tet torus (read and
+//! write) went 0.80 -> 0.62 s against `{:?}`. A reader that rounds correctly (strtod,
+//! Rust's parser) gets the exact same `f64` back.
 
 use std::io::{self, Write};
 
@@ -33,7 +35,7 @@ pub(crate) fn int<W: Write + ?Sized>(w: &mut W, v: i64) -> io::Result<()> {
 /// Write a float so that it parses back to the same bits.
 #[inline]
 pub(crate) fn float<W: Write + ?Sized>(w: &mut W, v: f64) -> io::Result<()> {
-    write!(w, "{v:?}")
+    w.write_all(zmij::Buffer::new().format(v).as_bytes())
 }
 
 /// Write `x y z` (space-separated, no line break).
