@@ -1,6 +1,6 @@
 //! Number output for the text writers, without a `String` per number.
 //!
-//! Floats use the shortest round-trip decimal ("0.1", "0.0000001", "1e-300", "NaN") by
+//! Floats use the shortest round-trip decimal ("0.1", "0.00006643", "1e-7", "1e+16", "NaN") by
 //! zmij, the formatter serde_json uses: `curvetet convert` of the 1M-tet torus (read and
 //! write) went 0.80 -> 0.62 s against `{:?}`. A reader that rounds correctly (strtod,
 //! Rust's parser) gets the exact same `f64` back.
