@@ -267,7 +267,7 @@ impl<'a> Mesher<'a> {
         // change the order the faces are taken in.)
         for k in 0..3 {
             if let Some(&g) = self.edges.get(&(v[(k + 1) % 3], v[k])) {
-                if self.wedge_deg(g, id) < WEDGE_FIRST_DEG {
+                if self.thin_wedge_deg(g, id).is_some() {
                     self.faces[g as usize].ver += 1;
                     self.enqueue(g);
                 }
@@ -277,21 +277,42 @@ impl<'a> Mesher<'a> {
 
     /// Unmeshed dihedral angle (degrees) at the edge shared by live faces `f` and `g`.
     fn wedge_deg(&self, f: u32, g: u32) -> f64 {
+        self.wedge_below(f, g, f64::INFINITY).unwrap_or(360.0)
+    }
+
+    /// [`Mesher::wedge_deg`] when it is below [`WEDGE_FIRST_DEG`] (the only wedges the
+    /// queue orders by angle), else `None`.
+    fn thin_wedge_deg(&self, f: u32, g: u32) -> Option<f64> {
+        self.wedge_below(f, g, WEDGE_FIRST_DEG)
+    }
+
+    /// The wedge angle at the edge of `f` and `g` if it is below `limit` (at most 75° or
+    /// infinite). Below 75° the angle is the one between the normals, so a cosine
+    /// clearly under cos 75° settles "not below" without the acos and the exact
+    /// predicate (the margin, 1e-9, is far above the cosine's rounding error, so the
+    /// outcome and the value are those of the full computation).
+    fn wedge_below(&self, f: u32, g: u32, limit: f64) -> Option<f64> {
+        /// cos 75°, less the margin.
+        const COS_LIMIT: f64 = 0.258_819_045_102_520_76 - 1e-9;
+        debug_assert!(limit <= WEDGE_FIRST_DEG || limit == f64::INFINITY);
         let fv = self.faces[f as usize].v;
         let gv = self.faces[g as usize].v;
         let fp = fv.map(|x| self.pts[x as usize]);
         let gp = gv.map(|x| self.pts[x as usize]);
         let n1 = normalize(tri_normal(fp[0], fp[1], fp[2]));
         let n2 = normalize(tri_normal(gp[0], gp[1], gp[2]));
-        let theta = (-dot(n1, n2)).clamp(-1.0, 1.0).acos().to_degrees();
-        let Some(&d) = gv.iter().find(|x| !fv.contains(x)) else {
-            return 360.0;
-        };
-        if orient3d(fp[0], fp[1], fp[2], self.pts[d as usize]) > 0 {
+        let cos = (-dot(n1, n2)).clamp(-1.0, 1.0);
+        if limit <= WEDGE_FIRST_DEG && cos < COS_LIMIT {
+            return None;
+        }
+        let theta = cos.acos().to_degrees();
+        let d = gv.iter().find(|x| !fv.contains(x))?;
+        let w = if orient3d(fp[0], fp[1], fp[2], self.pts[*d as usize]) > 0 {
             theta
         } else {
             360.0 - theta
-        }
+        };
+        (w < limit).then_some(w)
     }
 
     /// Queue live face `id` under its current version: faces in a thin wedge with a
@@ -303,7 +324,9 @@ impl<'a> Mesher<'a> {
         let mut wedge = 360.0f64;
         for k in 0..3 {
             if let Some(&g) = self.edges.get(&(f.v[(k + 1) % 3], f.v[k])) {
-                wedge = wedge.min(self.wedge_deg(id, g));
+                if let Some(w) = self.thin_wedge_deg(id, g) {
+                    wedge = wedge.min(w);
+                }
             }
         }
         let p = self.face_pts(id);
