@@ -66,30 +66,33 @@ impl QualityReport {
     /// already (the final check of `generate` has it; certifying again costs about a
     /// quarter of the report's time).
     pub fn with_invalid(m: &TetMesh, invalid: usize) -> QualityReport {
-        let q = element_qualities(m);
-        let vols: Vec<(f64, f64)> = (0..m.tets.len())
+        // One pass per element (its nodes loaded once): quality, straight and curved
+        // volume.
+        let per: Vec<(TetQuality, f64, f64)> = (0..m.tets.len())
             .into_par_iter()
             .map(|t| {
                 let x = tet_nodes(m, t);
                 (
+                    tet_quality(&x),
                     crate::geom::vec3::tet_det(x[0], x[1], x[2], x[3]) / 6.0,
                     tet10_volume(&x),
                 )
             })
             .collect();
         let mut summary = TetQualitySummary::new();
-        for e in &q {
-            summary.add(e);
+        for e in &per {
+            summary.add(&e.0);
         }
+        let q = || per.iter().map(|e| &e.0);
         QualityReport {
             num_tets: m.tets.len(),
             num_nodes: m.nodes.len(),
             num_boundary_faces: m.boundary.len(),
             num_invalid: invalid,
-            skew_above_085: q.iter().filter(|e| e.skewness > 0.85).count(),
-            skew_above_09: q.iter().filter(|e| e.skewness > 0.9).count(),
-            volume_linear: vols.iter().map(|v| v.0).collect::<CompensatedSum>().value(),
-            volume_curved: vols.iter().map(|v| v.1).collect::<CompensatedSum>().value(),
+            skew_above_085: q().filter(|e| e.skewness > 0.85).count(),
+            skew_above_09: q().filter(|e| e.skewness > 0.9).count(),
+            volume_linear: per.iter().map(|v| v.1).collect::<CompensatedSum>().value(),
+            volume_curved: per.iter().map(|v| v.2).collect::<CompensatedSum>().value(),
             quality: summary,
         }
     }
