@@ -7,7 +7,7 @@
 //! sifting is a visible share of the front's time at 1M tets.
 
 use std::cmp::Reverse;
-use std::collections::BinaryHeap;
+use std::collections::{BinaryHeap, VecDeque};
 
 /// Largest number of tries a face is queued with.
 pub const MAX_TRIES: u8 = 3;
@@ -44,10 +44,19 @@ pub fn size_class(key: f64) -> f64 {
 /// Number of heaps: one per (tries, class).
 const HEAPS: usize = (MAX_TRIES as usize + 1) * CLASSES as usize;
 
-/// The queue.
+/// Most runs per heap (see [`FaceQueue`]).
+const MAX_RUNS: usize = 16;
+
+/// The queue. Per (tries, class): a binary heap, and up to [`MAX_RUNS`] runs, each the
+/// entries of one key pushed in increasing order. Most faces are pushed once, when they
+/// are made, with ids that only grow, and the large inputs' size classes are few keys:
+/// so nearly every entry lands at the end of a run, O(1), instead of sifting through a
+/// heap of the whole front. A pop takes the smallest of the heap's top and the runs'
+/// fronts, so the order is exactly the heap-only order.
 #[derive(Default)]
 pub struct FaceQueue {
     heaps: [BinaryHeap<Reverse<(u64, u64)>>; HEAPS],
+    runs: [Vec<(u64, VecDeque<u64>)>; HEAPS],
 }
 
 impl FaceQueue {
@@ -57,20 +66,42 @@ impl FaceQueue {
     pub fn push(&mut self, tries: u8, class: u8, key: f64, id: u32, ver: u32) {
         debug_assert!(tries <= MAX_TRIES && class < CLASSES);
         let h = tries as usize * CLASSES as usize + class as usize;
-        self.heaps[h].push(Reverse((
-            total_order_bits(key),
-            (id as u64) << 32 | ver as u64,
-        )));
+        let (k, iv) = (total_order_bits(key), (id as u64) << 32 | ver as u64);
+        let runs = &mut self.runs[h];
+        match runs.iter().position(|r| r.0 == k) {
+            Some(i) if runs[i].1.back().map_or(true, |&b| b <= iv) => runs[i].1.push_back(iv),
+            None if runs.len() < MAX_RUNS => runs.push((k, VecDeque::from([iv]))),
+            _ => self.heaps[h].push(Reverse((k, iv))),
+        }
     }
 
     /// The smallest entry: (tries, face, version).
     #[inline]
     pub fn pop(&mut self) -> Option<(u8, u32, u32)> {
-        for (h, heap) in self.heaps.iter_mut().enumerate() {
-            if let Some(Reverse((_, iv))) = heap.pop() {
-                let tries = (h / CLASSES as usize) as u8;
-                return Some((tries, (iv >> 32) as u32, iv as u32));
+        for h in 0..HEAPS {
+            // The smallest run front, then against the heap's top.
+            let mut best: Option<(u64, u64, usize)> = None;
+            for (i, r) in self.runs[h].iter().enumerate() {
+                if let Some(&iv) = r.1.front() {
+                    if best.map_or(true, |b| (r.0, iv) < (b.0, b.1)) {
+                        best = Some((r.0, iv, i));
+                    }
+                }
             }
+            let top = self.heaps[h].peek().map(|e| e.0);
+            let iv = match (best, top) {
+                (Some((k, iv, i)), t) if t.map_or(true, |t| (k, iv) < t) => {
+                    self.runs[h][i].1.pop_front();
+                    iv
+                }
+                (_, Some(_)) => match self.heaps[h].pop() {
+                    Some(Reverse((_, iv))) => iv,
+                    None => continue,
+                },
+                _ => continue,
+            };
+            let tries = (h / CLASSES as usize) as u8;
+            return Some((tries, (iv >> 32) as u32, iv as u32));
         }
         None
     }
