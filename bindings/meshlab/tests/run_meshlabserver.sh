@@ -6,6 +6,7 @@
 #   run_meshlabserver.sh dump WORK            meshlabserver -d lists the filter
 #   run_meshlabserver.sh mesh WORK IN_LIN.OFF an .mlx script meshes the surface
 #   run_meshlabserver.sh open WORK CLOSED.OFF an open surface (one facet dropped) fails cleanly
+#   run_meshlabserver.sh smooth WORK RAW.OFF  smoothIterations 10 meshes a marching-cubes surface
 #   run_meshlabserver.sh readme WORK IN.OFF   the README's .mlx example ($README) runs
 #
 # Environment (set by CMakeLists.txt): MESHLABSERVER, XVFB_RUN, PLUGIN, CURVETET_CLI, PYTHON,
@@ -49,6 +50,7 @@ write_mlx() { # write_mlx FILE OUTPUT...: the filter once per output file
  <filter name="$filter">
   <Param type="RichFloat" name="alpha" value="1.5" description="Search radius factor"/>
   <Param type="RichFloat" name="featureAngle" value="40" description="Feature angle (degrees)"/>
+  <Param type="RichInt" name="smoothIterations" value="${SMOOTH:-0}" description="Smoothing iterations"/>
   <Param type="RichBool" name="optimize" value="true" description="Optimize"/>
   <Param type="RichSaveFile" name="outputFile" value="$out" ext=".msh" description="Output file (.msh or .vtu)"/>
  </filter>
@@ -62,10 +64,10 @@ case "$mode" in
 dump)
   server -d "$work/dump.txt" >"$work/log.txt" 2>&1 || { cat "$work/log.txt" >&2; fail "meshlabserver -d"; }
   grep -F "$filter" "$work/dump.txt" || fail "the filter is not listed by meshlabserver -d"
-  # Its section (up to the next filter's) lists the four parameters: type and label.
+  # Its section (up to the next filter's) lists the five parameters: type and label.
   sed -n "/\\\\section f[0-9]* $filter/,/^\\\\section/p" "$work/dump.txt" >"$work/section.txt"
-  for row in "Float .*Search radius factor" "Float .*Feature angle (degrees)" "Bool .*Optimize" \
-             "FileName .*Output file (.msh or .vtu)"; do
+  for row in "Float .*Search radius factor" "Float .*Feature angle (degrees)" \
+             "Int .*Smoothing iterations" "Bool .*Optimize" "FileName .*Output file (.msh or .vtu)"; do
     grep -q "$row" "$work/section.txt" || fail "parameter '$row' not listed"
   done
   echo "meshlabserver -d lists '$filter' with its parameters"
@@ -121,6 +123,21 @@ PY
   [ ! -e "$work/out.msh" ] || fail "an output file was written for a failed run"
   [ ! -e "$work/cut.ply" ] || fail "a layer was saved after a failed run"
   echo "open surface: the filter failed cleanly (meshlabserver exit code $rc)"
+  ;;
+smooth)
+  # A raw marching-cubes surface (tests/data/mc_blob.off: 101 of its 2,316 triangles have
+  # an aspect ratio above 10) with smoothIterations 10: it meshes, the log says it was
+  # smoothed, and the volume mesh passes curvetet check.
+  SMOOTH=10 write_mlx "$work/script.mlx" "$work/out.msh"
+  rc=0
+  server -i "$input" -o "$work/cut.ply" -l x -s "$work/script.mlx" >"$work/log.txt" 2>&1 || rc=$?
+  cat "$work/log.txt"
+  [ "$rc" = 0 ] || fail "meshlabserver exited with $rc"
+  grep -q "10 Taubin smoothing iterations" "$work/log.txt" || fail "the log does not say it smoothed"
+  grep -q "quadratic tets" "$work/log.txt" || fail "no tet count in the log"
+  [ -s "$work/out.msh" ] || fail "out.msh not written"
+  "$CURVETET_CLI" check "$work/out.msh" || fail "curvetet check out.msh"
+  echo "raw marching-cubes surface: smoothed (10 iterations) and meshed"
   ;;
 readme)
   # The README's filter script, as printed there, on a surface: runs, and its volume mesh
