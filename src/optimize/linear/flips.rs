@@ -43,7 +43,8 @@ pub(super) fn flip23(m: &mut LinMesh, t: u32, k: usize, eps: f64) -> bool {
     let new = [[f[0], f[1], e, d], [f[1], f[2], e, d], [f[2], f[0], e, d]];
     let mut q = [0.0; 3];
     for (qi, v) in q.iter_mut().zip(new.iter()) {
-        *qi = m.quality(*v);
+        // (A value at or below the floor is only compared with it: the cheap bound will do.)
+        *qi = m.quality_of_above(*v, old + eps);
         if *qi <= old + eps {
             return false;
         }
@@ -88,7 +89,10 @@ pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut Fli
         return false; // not a closed ring: a boundary or non-manifold edge
     }
     // Quality of the pair of tets on ring triangle (i, k, j), i < k < j: the tet
-    // (r_i, r_k, r_j, b) and (r_i, r_j, r_k, a) are positive for a convex ring.
+    // (r_i, r_k, r_j, b) and (r_i, r_j, r_k, a) are positive for a convex ring. Values at
+    // or below the floor `old + eps` may be any such value ([`LinMesh::quality_of_above`]):
+    // an interval whose best is at or below it is never used, so the triangulation chosen,
+    // and whether one is, are those of exact values.
     let idx = |i: usize, k: usize, j: usize| (i * n + k) * n + j;
     s.tri_q.clear();
     s.tri_q.resize(n * n * n, f64::NAN);
@@ -114,9 +118,10 @@ pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut Fli
                     let c = &mut s.tri_q[idx(i, k, j)];
                     if c.is_nan() {
                         let (ri, rk, rj) = (s.ring[i], s.ring[k], s.ring[j]);
-                        let qb = m.quality([ri, rk, rj, b]);
-                        *c = if qb > old + eps {
-                            qb.min(m.quality([ri, rj, rk, a]))
+                        let floor = old + eps;
+                        let qb = m.quality_of_above([ri, rk, rj, b], floor);
+                        *c = if qb > floor {
+                            qb.min(m.quality_of_above([ri, rj, rk, a], floor))
                         } else {
                             qb
                         };

@@ -13,6 +13,10 @@ use crate::geom::vec3::mid;
 pub(super) struct InsertScratch {
     ts: Vec<u32>,
     old: Vec<[u32; 4]>,
+    /// Qualities of `old`, restored on undo.
+    old_q: Vec<f64>,
+    /// Qualities of the new tets, two per old tet.
+    new_q: Vec<f64>,
     added: Vec<u32>,
 }
 
@@ -35,9 +39,11 @@ pub(super) fn split_edge(
     }
     let mut old_min = f64::INFINITY;
     s.old.clear();
+    s.old_q.clear();
     for &t in &s.ts {
         old_min = old_min.min(m.q[t as usize]);
         s.old.push(m.tets[t as usize]);
+        s.old_q.push(m.q[t as usize]);
     }
     let p = mid(m.pts[a as usize], m.pts[b as usize]);
     // The new tets (a, p, u, v) and (p, b, u, v) for each old (a, b, u, v); all must be
@@ -48,12 +54,13 @@ pub(super) fn split_edge(
     m.dirty.push(true);
     m.changed.push(m.clock);
     let mut ok = true;
+    s.new_q.clear();
     for &t in &s.ts {
         let (u, v) = opposite_edge(m.tets[t as usize], a, b);
         for nt in [[a, np, u, v], [np, b, u, v]] {
-            if m.quality(nt) == f64::NEG_INFINITY {
-                ok = false;
-            }
+            let q = m.quality(nt);
+            ok &= q != f64::NEG_INFINITY;
+            s.new_q.push(q);
         }
     }
     if !ok {
@@ -67,11 +74,11 @@ pub(super) fn split_edge(
         m.remove(s.ts[i]);
     }
     s.added.clear();
+    // (The qualities measured above: nothing has moved since.)
     for i in 0..s.old.len() {
         let (u, v) = opposite_edge(s.old[i], a, b);
-        for nt in [[a, np, u, v], [np, b, u, v]] {
-            let q = m.quality(nt);
-            let id = m.add(nt, q);
+        for (j, nt) in [[a, np, u, v], [np, b, u, v]].into_iter().enumerate() {
+            let id = m.add(nt, s.new_q[2 * i + j]);
             s.added.push(id);
         }
     }
@@ -87,10 +94,9 @@ pub(super) fn split_edge(
     for i in 0..s.added.len() {
         m.remove(s.added[i]);
     }
+    // (Their corners are where they were: the new vertex is in none of them.)
     for i in 0..s.old.len() {
-        let v = s.old[i];
-        let q = m.quality(v);
-        m.add(v, q);
+        m.add(s.old[i], s.old_q[i]);
     }
     false
 }

@@ -79,6 +79,12 @@ impl<'a> LinMesh<'a> {
         self.eq.eval(self.bnd, &self.pts, v, c)
     }
 
+    /// [`LinMesh::quality`] when it is above `floor`, else some value ≤ `floor`.
+    #[inline]
+    pub fn quality_of_above(&self, v: [u32; 4], floor: f64) -> f64 {
+        self.quality_above(v, &self.corners(v), floor)
+    }
+
     /// [`LinMesh::quality_at`] when it is above `floor`, else some value ≤ `floor`.
     #[inline]
     pub fn quality_above(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
