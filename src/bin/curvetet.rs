@@ -454,7 +454,10 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
             )));
         }
     }
-    let surface = read_surface_any(&a.input, &a.curve)?;
+    // The surface checks (parallel) run on as many threads as the meshing: `--threads 1`
+    // is one thread from start to end.
+    let surface = curvetet::threads::pool(a.mesh.threads)?
+        .install(|| read_surface_any(&a.input, &a.curve))?;
     if let Some(budget) = a.max_memory {
         let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
         if need > budget {
