@@ -9,7 +9,8 @@ use crate::geom::vec3::P3;
 use crate::mesh::quality::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::optimize::{
-    improve_linear, optimize_high_order, Boundary, HighOrderParams, LinearParams, OptimizeStats,
+    improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams,
+    OptimizeStats,
 };
 use crate::options::{Options, SizeFrom, SizeMode};
 use crate::{Error, Result, Surface};
@@ -142,8 +143,13 @@ fn generate_inner(
         let mut ostats = OptimizeStats::default();
         let (pts, tets) = if opts.optimize {
             let t = Instant::now();
-            let (pts, tets, st) =
-                improve_linear(front.pts, front.tets, &bnd, &LinearParams::default());
+            let (pts, tets, st) = improve_linear_known(
+                front.pts,
+                front.tets,
+                Some(&front.quality),
+                &bnd,
+                &LinearParams::default(),
+            );
             ostats.linear = st;
             ostats.time_linear = t.elapsed().as_secs_f64();
             (pts, tets)
@@ -371,5 +377,34 @@ mod tests {
         assert_eq!(msg, "stuck");
         let e = with_shape_hint(Error::Cancelled, &mc_blob(0));
         assert!(matches!(e, Error::Cancelled));
+    }
+
+    /// The corner qualities the front hands to the linear stage are, bit for bit, what
+    /// the linear stage would measure (it uses them instead of measuring).
+    #[test]
+    fn front_qualities_are_the_linear_stages() {
+        use crate::optimize::linear::ElementQuality;
+        let s = mc_blob(10);
+        let opts = Options::default();
+        let size = size_field(&s, &opts);
+        let front = run_front(s.nodes(), s.triangles(), &opts, &size, 0, &mut |_, _| false)
+            .expect("meshes");
+        assert_eq!(front.quality.len(), front.tets.len());
+        let bnd = Boundary::new(s.nodes().len(), s.triangles());
+        let mut used = 0;
+        for (t, &q) in front.tets.iter().zip(&front.quality) {
+            if q.is_nan() || t.iter().filter(|&&v| bnd.is_fixed(v)).count() >= 2 {
+                continue;
+            }
+            let c = t.map(|v| front.pts[v as usize]);
+            let e = ElementQuality.eval(&bnd, &front.pts, *t, &c);
+            assert_eq!(q.to_bits(), e.to_bits(), "tet {t:?}: {q} vs {e}");
+            used += 1;
+        }
+        assert!(
+            used > front.tets.len() / 2,
+            "{used} of {}",
+            front.tets.len()
+        );
     }
 }

@@ -325,7 +325,7 @@ impl Mesher<'_> {
                     let Some(&fid) = self.face_map.get(&super::key3(base)) else {
                         continue;
                     };
-                    self.insert_tet(t, fid);
+                    self.insert_tet(t, fid, f64::NAN);
                 }
                 return true;
             }

@@ -36,6 +36,10 @@ pub struct FrontOutput {
     pub pts: Vec<P3>,
     /// Positive tets (corner ids).
     pub tets: Vec<[u32; 4]>,
+    /// Per tet: 1 − equiangular skewness of its corners as the front measured it when it
+    /// chose the tet (`geom::quality`, the corners in tet order), NaN where it did not
+    /// measure (tets of filled cavities). The linear stage starts from these.
+    pub quality: Vec<f64>,
     /// Statistics of the run.
     pub stats: FrontStats,
 }
@@ -141,6 +145,8 @@ pub(crate) struct Mesher<'a> {
     grid: FaceGrid,
     vgrid: PointGrid,
     tets: Vec<[u32; 4]>,
+    /// [`FrontOutput::quality`] of each tet.
+    tet_q: Vec<f64>,
     tet_alive: Vec<bool>,
     size: &'a SizeField,
     /// Multiplies the size field (restarts refine).
@@ -204,6 +210,7 @@ impl<'a> Mesher<'a> {
             grid: FaceGrid::new(bounds, cell, max_cells),
             vgrid: PointGrid::new(bounds, cell, max_cells),
             tets: Vec::new(),
+            tet_q: Vec::new(),
             tet_alive: Vec::new(),
             size,
             size_scale: 1.0,
@@ -745,7 +752,9 @@ impl<'a> Mesher<'a> {
         } else {
             cd.id
         };
-        self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid);
+        // (The quality measured above, of these corners in this order; NaN was scored -1.)
+        let q = if cd.q >= 0.0 { cd.q } else { f64::NAN };
+        self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid, q);
         true
     }
 
@@ -830,10 +839,12 @@ impl<'a> Mesher<'a> {
         d
     }
 
-    fn insert_tet(&mut self, t: [u32; 4], base: u32) {
+    /// Add tet `t` on front face `base`, with its measured quality `q` (NaN: unknown).
+    fn insert_tet(&mut self, t: [u32; 4], base: u32, q: f64) {
         let tp = [0, 1, 2, 3].map(|k| self.pts[t[k] as usize]);
         self.volume_done += tet_det(tp[0], tp[1], tp[2], tp[3]) / 6.0;
         self.tets.push(t);
+        self.tet_q.push(q);
         self.tet_alive.push(true);
         self.kill_face(base);
         // (The point the base face's bound is for: its centroid as `advance` computes it.)
@@ -920,9 +931,17 @@ pub fn run_front(
                     .filter(|(_, a)| **a)
                     .map(|(t, _)| *t)
                     .collect();
+                let quality: Vec<f64> = m
+                    .tet_q
+                    .iter()
+                    .zip(&m.tet_alive)
+                    .filter(|(_, a)| **a)
+                    .map(|(q, _)| *q)
+                    .collect();
                 return Ok(FrontOutput {
                     pts: m.pts,
                     tets,
+                    quality,
                     stats: m.stats,
                 });
             }

@@ -34,7 +34,21 @@ pub(super) struct LinMesh<'a> {
 
 impl<'a> LinMesh<'a> {
     /// Build from the front's output.
+    #[cfg(test)]
     pub fn new(pts: Vec<P3>, tets: Vec<[u32; 4]>, bnd: &'a Boundary, eq: ElementQuality) -> Self {
+        Self::with_known(pts, tets, None, bnd, eq)
+    }
+
+    /// Build from the front's output. `known[i]`, when given and not NaN, is tet `i`'s
+    /// corner quality (1 − skewness, as [`ElementQuality`] scores a tet with fewer than
+    /// two boundary vertices); it is used for such tets instead of measuring again.
+    pub fn with_known(
+        pts: Vec<P3>,
+        tets: Vec<[u32; 4]>,
+        known: Option<&[f64]>,
+        bnd: &'a Boundary,
+        eq: ElementQuality,
+    ) -> Self {
         let mut vt = vec![Vec::new(); pts.len()];
         for (i, t) in tets.iter().enumerate() {
             for &v in t {
@@ -56,7 +70,13 @@ impl<'a> LinMesh<'a> {
         m.dirty = vec![true; m.pts.len()];
         m.changed = vec![1; m.pts.len()];
         for i in 0..m.tets.len() {
-            m.q[i] = m.quality(m.tets[i]);
+            let v = m.tets[i];
+            let k = known.and_then(|k| k.get(i)).copied().unwrap_or(f64::NAN);
+            m.q[i] = if !k.is_nan() && v.iter().filter(|&&x| bnd.is_fixed(x)).count() < 2 {
+                k
+            } else {
+                m.quality(v)
+            };
         }
         m
     }

@@ -112,8 +112,22 @@ pub fn improve_linear(
     bnd: &Boundary,
     prm: &LinearParams,
 ) -> (Vec<P3>, Vec<[u32; 4]>, LinearStats) {
+    improve_linear_known(pts, tets, None, bnd, prm)
+}
+
+/// [`improve_linear`] given the corner quality of each tet where it is known
+/// ([`crate::front::FrontOutput::quality`]: NaN where not), so that the stage does not
+/// measure every tet again (on the 1M-tet torus that was about 0.1 s). The result is the
+/// same.
+pub fn improve_linear_known(
+    pts: Vec<P3>,
+    tets: Vec<[u32; 4]>,
+    known: Option<&[f64]>,
+    bnd: &Boundary,
+    prm: &LinearParams,
+) -> (Vec<P3>, Vec<[u32; 4]>, LinearStats) {
     let goal = 1.0 - prm.goal_skewness;
-    let mut m = LinMesh::new(pts, tets, bnd, ElementQuality);
+    let mut m = LinMesh::with_known(pts, tets, known, bnd, ElementQuality);
     let mut st = LinearStats::default();
     let (w0, b0) = census(&m, goal);
     st.tets[0] = m.tets.len();
