@@ -108,11 +108,17 @@ impl Entities {
             }
         }
         surf.values_mut().for_each(finish);
-        let mut vol = EMPTY;
+        // The nodes the tets use, marked and then swept in order: the same box as growing
+        // it through the tets' nodes, without a random read of the node array for each.
+        let mut used = vec![false; view.nodes.len()];
         for t in view.tet10 {
             for &v in t {
-                grow(&mut vol, &view.nodes[v as usize]);
+                used[v as usize] = true;
             }
+        }
+        let mut vol = EMPTY;
+        for (p, _) in view.nodes.iter().zip(&used).filter(|(_, &u)| u) {
+            grow(&mut vol, p);
         }
         finish(&mut vol);
         (surf, vol)
