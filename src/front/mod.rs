@@ -306,8 +306,17 @@ impl<'a> Mesher<'a> {
         let gv = self.faces[g as usize].v;
         let fp = fv.map(|x| self.pts[x as usize]);
         let gp = gv.map(|x| self.pts[x as usize]);
-        let n1 = normalize(tri_normal(fp[0], fp[1], fp[2]));
-        let n2 = normalize(tri_normal(gp[0], gp[1], gp[2]));
+        let (r1, r2) = (tri_normal(fp[0], fp[1], fp[2]), tri_normal(gp[0], gp[1], gp[2]));
+        if limit <= WEDGE_FIRST_DEG {
+            // The same test on the raw normals, with another 1e-9 for the rounding of the
+            // normalized cosine below: most wedges end here, without normalizing.
+            let m = (norm2(r1) * norm2(r2)).sqrt();
+            if m.is_finite() && -dot(r1, r2) < (COS_LIMIT - 1e-9) * m {
+                return None;
+            }
+        }
+        let n1 = normalize(r1);
+        let n2 = normalize(r2);
         let cos = (-dot(n1, n2)).clamp(-1.0, 1.0);
         if limit <= WEDGE_FIRST_DEG && cos < COS_LIMIT {
             return None;
