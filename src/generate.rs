@@ -6,7 +6,7 @@ use crate::front::{run_front, FrontStats, RESTARTS};
 use crate::geom::quadrature::tri6_area;
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
-use crate::mesh::quality::{uncertified, QualityReport};
+use crate::mesh::quality::{self, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::optimize::{
     improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams,
@@ -127,7 +127,7 @@ fn generate_inner(
     // choice the greedy front makes, as for a front that cannot close). Bounded by
     // RESTARTS; the last attempt's result stands, whatever it is.
     let mut first = 0;
-    let (front_stats, mesh, ostats, conf, bad) = loop {
+    let (front_stats, mesh, ostats, conf, bad, measures) = loop {
         let t = Instant::now();
         let front = run_front(
             surface.nodes(),
@@ -181,7 +181,10 @@ fn generate_inner(
             return Err(Error::Cancelled);
         }
         let t = Instant::now();
-        let (conf, bad) = pool.install(|| (check::check_conformity(&mesh), uncertified(&mesh)));
+        // (The report's measures come from the same pass as the certification.)
+        let (conf, mut measures) =
+            pool.install(|| (check::check_conformity(&mesh), quality::measure(&mesh, true)));
+        let bad = std::mem::take(&mut measures.uncertified);
         times.certify += t.elapsed().as_secs_f64();
         let next = front.stats.restarts as usize + 1;
         if conf.is_ok() && !bad.is_empty() && next < RESTARTS.len() {
@@ -191,7 +194,7 @@ fn generate_inner(
             first = next;
             continue;
         }
-        break (front.stats, mesh, ostats, conf, bad);
+        break (front.stats, mesh, ostats, conf, bad, measures);
     };
     let conf = match conf {
         Ok(c) => c,
@@ -228,7 +231,8 @@ fn generate_inner(
     }
     let t = Instant::now();
     // `bad` is empty here: every element is certified.
-    let report = pool.install(|| QualityReport::with_invalid(&mesh, 0));
+    let report = QualityReport::from_measures(&mesh, &measures, 0);
+    drop(measures);
     times.report = t.elapsed().as_secs_f64();
     Ok(Generated {
         mesh,
