@@ -182,8 +182,12 @@ fn generate_inner(
         }
         let t = Instant::now();
         // (The report's measures come from the same pass as the certification.)
-        let (conf, mut measures) =
-            pool.install(|| (check::check_conformity(&mesh), quality::measure(&mesh, true)));
+        let (conf, mut measures) = pool.install(|| {
+            (
+                check::check_conformity(&mesh),
+                quality::measure(&mesh, true),
+            )
+        });
         let bad = std::mem::take(&mut measures.uncertified);
         times.certify += t.elapsed().as_secs_f64();
         let next = front.stats.restarts as usize + 1;

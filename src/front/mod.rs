@@ -306,7 +306,10 @@ impl<'a> Mesher<'a> {
         let gv = self.faces[g as usize].v;
         let fp = fv.map(|x| self.pts[x as usize]);
         let gp = gv.map(|x| self.pts[x as usize]);
-        let (r1, r2) = (tri_normal(fp[0], fp[1], fp[2]), tri_normal(gp[0], gp[1], gp[2]));
+        let (r1, r2) = (
+            tri_normal(fp[0], fp[1], fp[2]),
+            tri_normal(gp[0], gp[1], gp[2]),
+        );
         if limit <= WEDGE_FIRST_DEG {
             // The same test on the raw normals, with another 1e-9 for the rounding of the
             // normalized cosine below: most wedges end here, without normalizing.
