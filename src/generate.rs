@@ -6,7 +6,7 @@ use crate::front::{run_front, FrontStats, RESTARTS};
 use crate::geom::quadrature::tri6_area;
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
-use crate::mesh::quality::{self, QualityReport};
+use crate::mesh::quality::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::optimize::{
     improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams,
@@ -127,7 +127,7 @@ fn generate_inner(
     // choice the greedy front makes, as for a front that cannot close). Bounded by
     // RESTARTS; the last attempt's result stands, whatever it is.
     let mut first = 0;
-    let (front_stats, mesh, ostats, conf, bad, measures) = loop {
+    let (front_stats, mesh, ostats, conf, bad) = loop {
         let t = Instant::now();
         let front = run_front(
             surface.nodes(),
@@ -181,14 +181,7 @@ fn generate_inner(
             return Err(Error::Cancelled);
         }
         let t = Instant::now();
-        // (The report's measures come from the same pass as the certification.)
-        let (conf, mut measures) = pool.install(|| {
-            (
-                check::check_conformity(&mesh),
-                quality::measure(&mesh, true),
-            )
-        });
-        let bad = std::mem::take(&mut measures.uncertified);
+        let (conf, bad) = pool.install(|| (check::check_conformity(&mesh), uncertified(&mesh)));
         times.certify += t.elapsed().as_secs_f64();
         let next = front.stats.restarts as usize + 1;
         if conf.is_ok() && !bad.is_empty() && next < RESTARTS.len() {
@@ -198,7 +191,7 @@ fn generate_inner(
             first = next;
             continue;
         }
-        break (front.stats, mesh, ostats, conf, bad, measures);
+        break (front.stats, mesh, ostats, conf, bad);
     };
     let conf = match conf {
         Ok(c) => c,
@@ -235,8 +228,7 @@ fn generate_inner(
     }
     let t = Instant::now();
     // `bad` is empty here: every element is certified.
-    let report = QualityReport::from_measures(&mesh, &measures, 0);
-    drop(measures);
+    let report = pool.install(|| QualityReport::with_invalid(&mesh, 0));
     times.report = t.elapsed().as_secs_f64();
     Ok(Generated {
         mesh,

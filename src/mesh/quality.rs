@@ -33,37 +33,6 @@ pub fn uncertified(m: &TetMesh) -> Vec<usize> {
         .collect()
 }
 
-/// Every element's quality and straight and curved volume, and (when asked for) the
-/// elements not certified valid: one pass, each element's nodes loaded once (the final
-/// check of `generate` certifies and measures together).
-pub struct Measures {
-    per: Vec<(TetQuality, f64, f64)>,
-    /// Indices of the elements whose Jacobian is not certified positive (empty when
-    /// certification was not asked for).
-    pub uncertified: Vec<usize>,
-}
-
-/// Measure every element of `m` ([`Measures`]), certifying each when `certify_too`.
-pub fn measure(m: &TetMesh, certify_too: bool) -> Measures {
-    let per: Vec<(TetQuality, f64, f64, bool)> = (0..m.tets.len())
-        .into_par_iter()
-        .map(|t| {
-            let x = tet_nodes(m, t);
-            (
-                tet_quality(&x),
-                crate::geom::vec3::tet_det(x[0], x[1], x[2], x[3]) / 6.0,
-                tet10_volume(&x),
-                certify_too && !certify(&x).is_valid(),
-            )
-        })
-        .collect();
-    let uncertified = (0..per.len()).filter(|&t| per[t].3).collect();
-    Measures {
-        per: per.into_iter().map(|(q, a, b, _)| (q, a, b)).collect(),
-        uncertified,
-    }
-}
-
 /// What users and the paper measure on a mesh.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct QualityReport {
@@ -94,16 +63,24 @@ impl QualityReport {
     }
 
     /// Measure a mesh whose count of uncertified elements ([`uncertified`]) is known
-    /// already (certifying again costs about a quarter of the report's time).
+    /// already (the final check of `generate` has it; certifying again costs about a
+    /// quarter of the report's time).
     pub fn with_invalid(m: &TetMesh, invalid: usize) -> QualityReport {
-        Self::from_measures(m, &measure(m, false), invalid)
-    }
-
-    /// The report of a mesh measured by [`measure`], with `invalid` uncertified elements.
-    pub fn from_measures(m: &TetMesh, e: &Measures, invalid: usize) -> QualityReport {
-        let per = &e.per;
+        // One pass per element (its nodes loaded once): quality, straight and curved
+        // volume.
+        let per: Vec<(TetQuality, f64, f64)> = (0..m.tets.len())
+            .into_par_iter()
+            .map(|t| {
+                let x = tet_nodes(m, t);
+                (
+                    tet_quality(&x),
+                    crate::geom::vec3::tet_det(x[0], x[1], x[2], x[3]) / 6.0,
+                    tet10_volume(&x),
+                )
+            })
+            .collect();
         let mut summary = TetQualitySummary::new();
-        for e in per {
+        for e in &per {
             summary.add(&e.0);
         }
         let q = || per.iter().map(|e| &e.0);
