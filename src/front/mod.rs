@@ -936,20 +936,11 @@ pub fn run_front(
         m.stats.size_scale = fs;
         match m.run(progress) {
             Ok(()) => {
-                let tets: Vec<[u32; 4]> = m
-                    .tets
-                    .iter()
-                    .zip(&m.tet_alive)
-                    .filter(|(_, a)| **a)
-                    .map(|(t, _)| *t)
-                    .collect();
-                let quality: Vec<f64> = m
-                    .tet_q
-                    .iter()
-                    .zip(&m.tet_alive)
-                    .filter(|(_, a)| **a)
-                    .map(|(q, _)| *q)
-                    .collect();
+                // The live tets and their qualities.
+                let alive = |i: &usize| m.tet_alive[*i];
+                let live = || (0..m.tets.len()).filter(alive);
+                let tets: Vec<[u32; 4]> = live().map(|i| m.tets[i]).collect();
+                let quality: Vec<f64> = live().map(|i| m.tet_q[i]).collect();
                 return Ok(FrontOutput {
                     pts: m.pts,
                     tets,
