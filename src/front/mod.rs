@@ -295,12 +295,11 @@ impl<'a> Mesher<'a> {
 
     /// The wedge angle at the edge of `f` and `g` if it is below `limit` (at most 75° or
     /// infinite). Below 75° the angle is the one between the normals, so a cosine
-    /// clearly under cos 75° settles "not below" without the acos and the exact
-    /// predicate (the margin, 1e-9, is far above the cosine's rounding error, so the
+    /// clearly under cos 75° settles "not below" without normalizing, the acos and the
+    /// exact predicate (the margin, 2e-9, is far above the cosine's rounding error, so the
     /// outcome and the value are those of the full computation).
     fn wedge_below(&self, f: u32, g: u32, limit: f64) -> Option<f64> {
-        /// cos 75°, less the margin.
-        const COS_LIMIT: f64 = 0.258_819_045_102_520_76 - 1e-9;
+        const COS_75: f64 = 0.258_819_045_102_520_76;
         debug_assert!(limit <= WEDGE_FIRST_DEG || limit == f64::INFINITY);
         let fv = self.faces[f as usize].v;
         let gv = self.faces[g as usize].v;
@@ -311,19 +310,12 @@ impl<'a> Mesher<'a> {
             tri_normal(gp[0], gp[1], gp[2]),
         );
         if limit <= WEDGE_FIRST_DEG {
-            // The same test on the raw normals, with another 1e-9 for the rounding of the
-            // normalized cosine below: most wedges end here, without normalizing.
             let m = (norm2(r1) * norm2(r2)).sqrt();
-            if m.is_finite() && -dot(r1, r2) < (COS_LIMIT - 1e-9) * m {
+            if m.is_finite() && -dot(r1, r2) < (COS_75 - 2e-9) * m {
                 return None;
             }
         }
-        let n1 = normalize(r1);
-        let n2 = normalize(r2);
-        let cos = (-dot(n1, n2)).clamp(-1.0, 1.0);
-        if limit <= WEDGE_FIRST_DEG && cos < COS_LIMIT {
-            return None;
-        }
+        let cos = (-dot(normalize(r1), normalize(r2))).clamp(-1.0, 1.0);
         let theta = cos.acos().to_degrees();
         let d = gv.iter().find(|x| !fv.contains(x))?;
         let w = if orient3d(fp[0], fp[1], fp[2], self.pts[*d as usize]) > 0 {

@@ -94,10 +94,10 @@ impl FaceQueue {
                     self.runs[h][i].1.pop_front();
                     iv
                 }
-                (_, Some(_)) => match self.heaps[h].pop() {
-                    Some(Reverse((_, iv))) => iv,
-                    None => continue,
-                },
+                (_, Some((_, iv))) => {
+                    self.heaps[h].pop();
+                    iv
+                }
                 _ => continue,
             };
             let tries = (h / CLASSES as usize) as u8;

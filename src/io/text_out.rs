@@ -16,10 +16,7 @@ pub(crate) fn uint<W: Write + ?Sized>(w: &mut W, v: u64) -> io::Result<()> {
 /// Write a signed integer in decimal.
 #[inline]
 pub(crate) fn int<W: Write + ?Sized>(w: &mut W, v: i64) -> io::Result<()> {
-    if v < 0 {
-        w.write_all(b"-")?;
-    }
-    uint(w, v.unsigned_abs())
+    w.write_all(itoa::Buffer::new().format(v).as_bytes())
 }
 
 /// Write a float so that it parses back to the same bits.

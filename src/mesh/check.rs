@@ -184,32 +184,25 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
     }
     // One mid node per edge: every tet's equals that of the first tet holding the edge,
     // and the boundary's on boundary edges.
-    let mid_err = (at.bad_mid != usize::MAX)
-        .then_some(at.bad_mid)
-        .and_then(|ti| {
-            let t = &m.tets[ti];
-            for (e, [i, j]) in TET10_EDGES.iter().enumerate() {
-                let (a, b) = (t[*i], t[*j]);
-                let mnode = t[4 + e];
-                // Tet ti itself holds the edge: there is a first tet.
-                let prev = inc.edge_mid(m, a, b).unwrap_or(mnode);
-                if prev != mnode {
-                    return Some(bad(
-                        vec![ti],
-                        format!("edge ({a}, {b}) has two mid nodes ({prev} and {mnode}); tet {ti}"),
-                    ));
-                }
-            }
-            None
-        });
-    if let Some(e) = mid_err {
-        return Err(e);
-    }
     if at.bad_mid != usize::MAX {
+        let ti = at.bad_mid;
+        let t = &m.tets[ti];
+        for (e, [i, j]) in TET10_EDGES.iter().enumerate() {
+            let (a, b) = (t[*i], t[*j]);
+            let mnode = t[4 + e];
+            // Tet ti itself holds the edge: there is a first tet.
+            let prev = inc.edge_mid(m, a, b).unwrap_or(mnode);
+            if prev != mnode {
+                return Err(bad(
+                    vec![ti],
+                    format!("edge ({a}, {b}) has two mid nodes ({prev} and {mnode}); tet {ti}"),
+                ));
+            }
+        }
         // (Unreachable, as for faces.)
         return Err(bad(
-            vec![at.bad_mid],
-            format!("tet {} has an edge with two mid nodes", at.bad_mid),
+            vec![ti],
+            format!("tet {ti} has an edge with two mid nodes"),
         ));
     }
     let bmid_err = m.boundary.par_iter().enumerate().find_map_first(|(bi, b)| {
