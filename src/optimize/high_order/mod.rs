@@ -239,7 +239,9 @@ pub fn optimize_high_order(
             patches.push(p);
         }
         let colours = colour(&patches, ne);
+        let t0 = std::time::Instant::now();
         let done = schedule::run_round(mesh, &patches, &colours, &mut sj, prm);
+        if std::env::var("CT_DBG").is_ok() { eprintln!("round {round} patches {} colours {} elems {:?} work {} t {:.2}ms", patches.len(), colours.iter().max().unwrap()+1, patches.iter().map(|p| p.elems.len()).collect::<Vec<_>>(), done.work, t0.elapsed().as_secs_f64()*1e3); }
         st.patches += patches.len();
         st.patch_elements += patches.iter().map(|p| p.elems.len() as u64).sum::<u64>();
         st.element_evaluations += done.work;
@@ -284,11 +286,14 @@ fn run_barrier(
     h: f64,
     prm: &HighOrderParams,
     lb: &mut Lbfgs,
+    lone: &dyn Fn() -> bool,
 ) -> u64 {
     let mut obj = Objective {
         elems,
         eps: 0.0,
         last_ratio: Default::default(),
+        outs: Default::default(),
+        lone,
     };
     let (mut mmin, ratio) = obj.min_measure(v);
     let mut evals = 0u64;
@@ -321,35 +326,54 @@ fn run_barrier(
 }
 
 /// Scores of `elems` at `v`, their minimum and (when `with_skew`, else 0) the largest
-/// corner skewness.
+/// corner skewness. In parallel parts when the patch runs `lone` (see
+/// [`objective::parallel_parts`]); the result is the same.
 fn evaluate(
     elems: &[PatchElem],
     v: &[f64],
     enough: f64,
     with_skew: bool,
     out: &mut Vec<f64>,
+    lone: &dyn Fn() -> bool,
 ) -> (f64, f64) {
-    out.clear();
-    let mut lo = f64::INFINITY;
-    let mut sk = 0.0f64;
-    let mut xs = [[[0.0; 3]; 10]; L];
-    for chunk in elems.chunks(L) {
-        objective::gather(chunk, v, &mut xs);
-        let sc = objective::score_block(&xs, chunk.len(), enough);
-        for (xe, &s) in xs.iter().zip(&sc).take(chunk.len()) {
-            lo = lo.min(s);
-            if with_skew {
+    // Score and corner skewness of each element of `elems` into `o`.
+    let score = |elems: &[PatchElem], o: &mut [(f64, f64)]| {
+        let mut xs = [[[0.0; 3]; 10]; L];
+        for (chunk, o) in elems.chunks(L).zip(o.chunks_mut(L)) {
+            objective::gather(chunk, v, &mut xs);
+            let sc = objective::score_block(&xs, chunk.len(), enough);
+            for ((xe, &s), o) in xs.iter().zip(&sc).zip(o.iter_mut()) {
                 // An inverted corner tet counts as the worst skewness: the final check
                 // wants every corner tet positive, whatever the curved Jacobian says.
-                sk = if orient3d(xe[0], xe[1], xe[2], xe[3]) > 0 {
-                    sk.max(skew(xe))
+                let k = if !with_skew {
+                    0.0
+                } else if orient3d(xe[0], xe[1], xe[2], xe[3]) > 0 {
+                    skew(xe)
                 } else {
                     f64::INFINITY
                 };
+                *o = (s, k);
             }
-            out.push(s);
         }
+    };
+    let mut res = vec![(0.0, 0.0); elems.len()];
+    let parts = if lone() {
+        objective::parallel_parts(elems.len())
+    } else {
+        1
+    };
+    if parts > 1 {
+        let per = elems.len().div_ceil(L).div_ceil(parts) * L;
+        res.par_chunks_mut(per)
+            .zip(elems.par_chunks(per))
+            .for_each(|(o, e)| score(e, o));
+    } else {
+        score(elems, &mut res);
     }
+    out.clear();
+    out.extend(res.iter().map(|r| r.0));
+    let lo = res.iter().fold(f64::INFINITY, |a, r| a.min(r.0));
+    let sk = res.iter().fold(0.0f64, |a, r| a.max(r.1));
     (lo, sk)
 }
 
@@ -422,7 +446,12 @@ fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &HighOrderP
 /// A's result with the free vertices too, kept only if their corner skewness stays
 /// within [`HighOrderParams::max_skewness`] ([`HighOrderParams::max_skewness_rescue`]
 /// for a poor patch), or below the patch's previous worst.
-fn run_patch(job: PatchJob, prm: &HighOrderParams, lb: &mut Lbfgs) -> (Option<PatchResult>, u64) {
+fn run_patch(
+    job: PatchJob,
+    prm: &HighOrderParams,
+    lb: &mut Lbfgs,
+    lone: &dyn Fn() -> bool,
+) -> (Option<PatchResult>, u64) {
     let PatchJob {
         elems,
         h,
@@ -444,7 +473,7 @@ fn run_patch(job: PatchJob, prm: &HighOrderParams, lb: &mut Lbfgs) -> (Option<Pa
     let v0 = v.clone();
     let mut work = 0;
     if !mids.is_empty() {
-        work += run_barrier(&mids, &mut v, h, prm, lb);
+        work += run_barrier(&mids, &mut v, h, prm, lb, lone);
     }
     let mut scores = Vec::with_capacity(elems.len());
     let deficit = |s: &[f64]| s.iter().map(|&x| (prm.threshold - x).max(0.0)).sum::<f64>();
@@ -453,7 +482,7 @@ fn run_patch(job: PatchJob, prm: &HighOrderParams, lb: &mut Lbfgs) -> (Option<Pa
     // so improving a patch's other bad elements counts too.
     let better = |m: f64, d: f64, bm: f64, bd: f64| m > bm || (m >= bm - 1e-6 && d < bd - 1e-4);
     // Corners did not move: no skewness to check.
-    let (mut best_min, _) = evaluate(&elems, &v, prm.threshold, false, &mut scores);
+    let (mut best_min, _) = evaluate(&elems, &v, prm.threshold, false, &mut scores, lone);
     let mut best_def = deficit(&scores);
     let mut best: Option<(Vec<f64>, Vec<f64>)> = None;
     if v != v0 && better(best_min, best_def, before_min, before_def) {
@@ -467,9 +496,9 @@ fn run_patch(job: PatchJob, prm: &HighOrderParams, lb: &mut Lbfgs) -> (Option<Pa
     let has_vertex = elems.iter().any(|e| e.var[..4].iter().any(|&i| i != FIXED));
     if prm.move_vertices && has_vertex && best_min < prm.threshold.min(prm.vertices_below) {
         let vb = v.clone();
-        work += run_barrier(&elems, &mut v, h, prm, lb);
+        work += run_barrier(&elems, &mut v, h, prm, lb, lone);
         if v != vb {
-            let (lo, sk) = evaluate(&elems, &v, prm.threshold, true, &mut scores);
+            let (lo, sk) = evaluate(&elems, &v, prm.threshold, true, &mut scores, lone);
             let cap = if before_min < prm.rescue_below {
                 prm.max_skewness_rescue
             } else {

@@ -17,6 +17,7 @@
 
 use super::jacobian::bezier_forward;
 use super::lanes::{self, L};
+use rayon::prelude::*;
 use crate::geom::bezier::scaled_jacobian_certified;
 use crate::geom::quality::DEFAULT_SJ_REL_TOL;
 use crate::geom::vec3::{mid, P3};
@@ -156,6 +157,11 @@ pub(super) struct Objective<'a> {
     /// Smallest min b / max b of the last point [`Objective::eval`] saw (computed on the
     /// way, for stopping as soon as a target is reached).
     pub last_ratio: std::cell::Cell<f64>,
+    /// Per-block results of a parallel [`Objective::eval`], reused across calls.
+    pub outs: std::cell::RefCell<Vec<lanes::BlockOut>>,
+    /// Whether this patch is the only one of its round still running, so that the other
+    /// threads are idle and may evaluate parts of it (asked at every evaluation).
+    pub lone: &'a dyn Fn() -> bool,
 }
 
 /// The nodes of `e` for variables `v`.
@@ -224,7 +230,9 @@ impl Objective<'_> {
     }
 
     /// Objective at `v`, gradient into `g`. Elements go through [`lanes::eval_block`]
-    /// [`L`] at a time (bit-identical to one at a time; tested).
+    /// [`L`] at a time (bit-identical to one at a time; tested). A large patch has its
+    /// blocks evaluated in parallel ([`parallel_parts`]); their sums and gradients are
+    /// still added in element order, so the result does not depend on the thread count.
     pub fn eval(&self, v: &[f64], g: &mut [f64]) -> f64 {
         g.iter_mut().for_each(|x| *x = 0.0);
         let eps = self.eps;
@@ -232,29 +240,85 @@ impl Objective<'_> {
         let mut total = 0.0;
         let mut ratio = f64::INFINITY;
         self.last_ratio.set(f64::NEG_INFINITY);
-        let mut xs = [[[0.0; 3]; 10]; L];
-        let mut delta = [0.0; L];
-        let mut out = lanes::BlockOut::default();
-        for chunk in self.elems.chunks(L) {
-            gather(chunk, v, &mut xs);
-            for (l, d) in delta.iter_mut().enumerate() {
-                *d = chunk[l.min(chunk.len() - 1)].delta;
-            }
-            lanes::eval_block(&xs, delta, eps, lden, &mut out);
-            for (l, e) in chunk.iter().enumerate() {
-                ratio = ratio.min(out.ratio[l]);
-                if !out.ok[l] {
+        let parts = if (self.lone)() {
+            parallel_parts(self.elems.len())
+        } else {
+            1
+        };
+        if parts > 1 {
+            let mut outs = self.outs.borrow_mut();
+            outs.resize_with(self.elems.len().div_ceil(L), Default::default);
+            let per = outs.len().div_ceil(parts);
+            outs.par_chunks_mut(per)
+                .zip(self.elems.par_chunks(per * L))
+                .for_each(|(outs, elems)| {
+                    for (out, chunk) in outs.iter_mut().zip(elems.chunks(L)) {
+                        eval_chunk(chunk, v, eps, lden, out);
+                    }
+                });
+            for (out, chunk) in outs.iter().zip(self.elems.chunks(L)) {
+                if !add_chunk(chunk, out, g, &mut total, &mut ratio) {
                     return f64::INFINITY;
                 }
-                total += out.part[l];
-                let gx = &mut out.gx[l];
-                follow_corners(e, gx);
-                scatter(e, gx, g);
+            }
+        } else {
+            let mut out = lanes::BlockOut::default();
+            for chunk in self.elems.chunks(L) {
+                eval_chunk(chunk, v, eps, lden, &mut out);
+                if !add_chunk(chunk, &out, g, &mut total, &mut ratio) {
+                    return f64::INFINITY;
+                }
             }
         }
         self.last_ratio.set(ratio);
         total
     }
+}
+
+/// Into how many parts to split the evaluation of `n` elements: one per thread of the
+/// current rayon pool, each of at least [`PART_ELEMS`] elements (below that, the hand-off
+/// costs more than it saves). Only for a patch running alone: a thread waiting for its
+/// part to come back steals other work, and another patch would hold it far longer.
+pub(super) fn parallel_parts(n: usize) -> usize {
+    (n / PART_ELEMS).min(rayon::current_num_threads()).max(1)
+}
+
+/// See [`parallel_parts`].
+const PART_ELEMS: usize = 32;
+
+/// [`lanes::eval_block`] on the elements of `chunk` (at most [`L`]) at `v`, with the
+/// gradient of each free mid node's offset passed on to its edge's corners.
+#[inline]
+fn eval_chunk(chunk: &[PatchElem], v: &[f64], eps: f64, lden: f64, out: &mut lanes::BlockOut) {
+    let mut xs = [[[0.0; 3]; 10]; L];
+    gather(chunk, v, &mut xs);
+    let delta = std::array::from_fn(|l| chunk[l.min(chunk.len() - 1)].delta);
+    lanes::eval_block(&xs, delta, eps, lden, out);
+    for (e, gx) in chunk.iter().zip(out.gx.iter_mut()) {
+        follow_corners(e, gx);
+    }
+}
+
+/// Add the results `out` of `chunk` to the objective `total`, its gradient `g` and the
+/// smallest `ratio`, element by element; false (the rest not added) at the first element
+/// outside the barrier.
+#[inline]
+fn add_chunk(
+    chunk: &[PatchElem],
+    out: &lanes::BlockOut,
+    g: &mut [f64],
+    total: &mut f64,
+    ratio: &mut f64,
+) -> bool {
+    for (l, e) in chunk.iter().enumerate() {
+        *ratio = ratio.min(out.ratio[l]);
+        if !out.ok[l] {
+            return false;
+        }
+        *total += out.part[l];
+        scatter(e, &out.gx[l], g);
+    }
+    true
 }
 
 /// Mid nodes follow their corners (x_m = (x_a + x_b)/2 + offset): the gradient of a free
@@ -335,6 +399,8 @@ mod tests {
             elems: &elems,
             eps: -0.5,
             last_ratio: Default::default(),
+            outs: Default::default(),
+            lone: &|| false,
         };
         let mut v = vec![0.01; 21];
         v[..3].copy_from_slice(&x[3]);
@@ -424,6 +490,11 @@ mod tests {
                     elems: &elems,
                     eps: rng.random_range(-0.5..0.1),
                     last_ratio: Default::default(),
+                    outs: Default::default(),
+                    lone: &|| false,
+            lone: &|| false,
+            outs: Default::default(),
+            lone: &|| false,
                 };
                 let (mut g1, mut g2) = (vec![0.0; 12], vec![0.0; 12]);
                 let f1 = obj.eval(&v, &mut g1);
@@ -482,6 +553,8 @@ mod tests {
             elems: &elems,
             eps: 0.2,
             last_ratio: Default::default(),
+            outs: Default::default(),
+            lone: &|| false,
         };
         let mut g = vec![0.0; 9];
         let f0 = obj.eval(&v0, &mut g);

@@ -16,6 +16,7 @@ use super::patch::Patch;
 use super::{prepare, run_patch, HighOrderParams, PatchResult};
 use crate::geom::vec3::P3;
 use crate::mesh::TetMesh;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError, RwLock};
 
 /// What a round did.
@@ -89,6 +90,8 @@ struct Round<'a, 'm> {
     prm: &'a HighOrderParams,
     state: RwLock<State<'m>>,
     progress: Mutex<Progress>,
+    /// Patches spawned and not yet done (running or queued).
+    live: AtomicUsize,
 }
 
 /// Optimize `patches` (coloured by `colours`) on the current rayon pool, writing kept
@@ -121,6 +124,7 @@ pub(super) fn run_round(
             pending,
             done: RoundDone::default(),
         }),
+        live: AtomicUsize::new(0),
     };
     rayon::scope(|s| {
         for i in ready {
@@ -137,16 +141,22 @@ pub(super) fn run_round(
 /// Run patch `i` as a task of scope `s` (its dependencies are done); when it is done,
 /// write its result and start the patches that were waiting only for it.
 fn spawn<'s, 'a: 's, 'm: 's>(s: &rayon::Scope<'s>, round: &'s Round<'a, 'm>, i: usize) {
+    round.live.fetch_add(1, Ordering::SeqCst);
     s.spawn(move |s| {
         let job = {
             let st = round.state.read().unwrap_or_else(PoisonError::into_inner);
             prepare(round.tets, st.nodes, &round.patches[i], st.sj, round.prm)
         };
         let mut lb = Lbfgs::default();
-        let (result, work) = run_patch(job, round.prm, &mut lb);
+        // Alone: no other patch is running or waiting to run, and none can start before
+        // this one is done (only a finished patch releases others).
+        let lone = || round.live.load(Ordering::SeqCst) == 1;
+        let (result, work) = run_patch(job, round.prm, &mut lb, &lone);
         for k in finish(round, i, result, work) {
             spawn(s, round, k);
         }
+        // After the released patches count as live, so that none runs alone too early.
+        round.live.fetch_sub(1, Ordering::SeqCst);
     });
 }
 
@@ -205,7 +215,7 @@ mod tests {
                 .map(|&i| prepare(&mesh.tets, &mesh.nodes, &patches[i], sj, prm))
                 .collect();
             for (&i, job) in batch.iter().zip(jobs) {
-                let (r, w) = run_patch(job, prm, &mut Lbfgs::default());
+                let (r, w) = run_patch(job, prm, &mut Lbfgs::default(), &|| false);
                 work += w;
                 let Some(r) = r else { continue };
                 improved += 1;
