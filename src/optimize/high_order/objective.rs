@@ -492,9 +492,6 @@ mod tests {
                     last_ratio: Default::default(),
                     outs: Default::default(),
                     lone: &|| false,
-            lone: &|| false,
-            outs: Default::default(),
-            lone: &|| false,
                 };
                 let (mut g1, mut g2) = (vec![0.0; 12], vec![0.0; 12]);
                 let f1 = obj.eval(&v, &mut g1);
