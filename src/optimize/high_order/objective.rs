@@ -17,10 +17,10 @@
 
 use super::jacobian::bezier_forward;
 use super::lanes::{self, L};
-use rayon::prelude::*;
 use crate::geom::bezier::scaled_jacobian_certified;
 use crate::geom::quality::DEFAULT_SJ_REL_TOL;
 use crate::geom::vec3::{mid, P3};
+use rayon::prelude::*;
 
 /// No variable.
 pub(super) const FIXED: u32 = u32::MAX;
