@@ -609,6 +609,39 @@ mod tests {
     }
 
     #[test]
+    fn length_scales_are_the_mean_edge_of_the_elements_at_a_node() {
+        let unit = crate::geom::shape::straight_tet10([
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ]);
+        let twice = unit.map(|p| p.map(|c| 2.0 * c));
+        let mean = |x: &[P3; 10]| {
+            crate::geom::shape::TET10_EDGES
+                .iter()
+                .map(|&[a, b]| dist(x[a], x[b]))
+                .sum::<f64>()
+                / 6.0
+        };
+        // Variable 0 (a mid node) in both elements, variable 1 (a corner) in the second.
+        let mut va = [FIXED; 10];
+        va[4] = 0;
+        let mut vb = [FIXED; 10];
+        vb[5] = 0;
+        vb[3] = 1;
+        let elems = [PatchElem::new(unit, va), PatchElem::new(twice, vb)];
+        let s = length_scales(&elems, 2);
+        assert_eq!(s.len(), 6);
+        let both = (mean(&unit) + mean(&twice)) / 2.0;
+        for d in 0..3 {
+            assert!((s[d] - both).abs() < 1e-15);
+            assert!((s[3 + d] - mean(&twice)).abs() < 1e-15);
+        }
+        assert!((mean(&twice) - 2.0 * mean(&unit)).abs() < 1e-15);
+    }
+
+    #[test]
     fn untangles_an_invalid_patch_and_keeps_the_boundary() {
         let c = cube(3, 0.05);
         let bnd = c.boundary();

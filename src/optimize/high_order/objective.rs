@@ -524,6 +524,65 @@ mod tests {
     }
 
     #[test]
+    fn parallel_parts_give_the_serial_result_bit_for_bit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+        let base = curved_tet();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        for (n_el, eps) in [(137usize, -10.0), (64, -10.0), (137, 0.97)] {
+            // Elements sharing the four variables (so that the order in which gradients
+            // are added matters to the last bit).
+            let elems: Vec<PatchElem> = (0..n_el)
+                .map(|_| {
+                    let mut x = base;
+                    for c in x.iter_mut().flatten() {
+                        *c += rng.random_range(-0.03..0.03);
+                    }
+                    let var = std::array::from_fn(|k| {
+                        if k == 3 || k >= 6 {
+                            (k % 4) as u32
+                        } else {
+                            FIXED
+                        }
+                    });
+                    PatchElem::new(x, var)
+                })
+                .collect();
+            let mut v: Vec<f64> = (0..12).map(|_| rng.random_range(-0.01..0.01)).collect();
+            v[9..12].copy_from_slice(&base[3]);
+            let run = |lone: bool| {
+                pool.install(|| {
+                    assert!(parallel_parts(n_el) == 2);
+                    let yes = || lone;
+                    let obj = Objective {
+                        elems: &elems,
+                        eps,
+                        last_ratio: Default::default(),
+                        outs: Default::default(),
+                        lone: &yes,
+                    };
+                    let mut g = vec![0.0; 12];
+                    let f = obj.eval(&v, &mut g);
+                    (f, g, obj.last_ratio.get())
+                })
+            };
+            let (f1, g1, r1) = run(false);
+            let (f2, g2, r2) = run(true);
+            assert_eq!(f1.to_bits(), f2.to_bits(), "{f1} vs {f2}");
+            assert_eq!(f1.is_finite(), eps < 0.0, "{f1}");
+            if f1.is_finite() {
+                assert_eq!(r1.to_bits(), r2.to_bits());
+                for (a, b) in g1.iter().zip(&g2) {
+                    assert_eq!(a.to_bits(), b.to_bits(), "{a} vs {b}");
+                }
+            }
+        }
+    }
+
+    #[test]
     fn gradient_matches_finite_differences() {
         let mut x = curved_tet();
         x[9][0] -= 0.04;
