@@ -7,7 +7,9 @@
 //! same result as colour by colour), by a sequence of L-BFGS runs on the log-barrier
 //! objective ([`objective`]) with the barrier moved up to just below the current minimum
 //! after each run (Gmsh's moving barrier; it starts from any state, including invalid
-//! elements). A patch's result is kept only when the certified minimum min J / max J of
+//! elements), each variable measured in its node's local edge length. A patch that runs
+//! alone (the rest of its round waiting for it) has its elements evaluated by every
+//! thread. A patch's result is kept only when the certified minimum min J / max J of
 //! its active elements rose (and, if vertices moved, their skewness stayed within
 //! bounds); the output does not depend on the thread count. Surface nodes are never
 //! variables.
