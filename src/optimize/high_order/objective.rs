@@ -459,33 +459,39 @@ mod tests {
         total
     }
 
+    /// `n_el` copies of [`curved_tet`] with every node shaken by up to 0.03, sharing four
+    /// variables (corner 3 and mids 6..9, so that the order in which their gradients are
+    /// added matters to the last bit), and a point near the start for them.
+    fn shaken_patch(rng: &mut impl rand::Rng, n_el: usize) -> (Vec<PatchElem>, Vec<f64>) {
+        let base = curved_tet();
+        let elems = (0..n_el)
+            .map(|_| {
+                let mut x = base;
+                for c in x.iter_mut().flatten() {
+                    *c += rng.random_range(-0.03..0.03);
+                }
+                let var = std::array::from_fn(|k| {
+                    if k == 3 || k >= 6 {
+                        (k % 4) as u32
+                    } else {
+                        FIXED
+                    }
+                });
+                PatchElem::new(x, var)
+            })
+            .collect();
+        let mut v: Vec<f64> = (0..12).map(|_| rng.random_range(-0.01..0.01)).collect();
+        v[9..12].copy_from_slice(&base[3]);
+        (elems, v)
+    }
+
     #[test]
     fn lanes_match_one_element_at_a_time_bit_for_bit() {
         use rand::{Rng, SeedableRng};
         let mut rng = rand::rngs::StdRng::seed_from_u64(11);
-        let base = curved_tet();
         for n_el in [1usize, 3, 4, 5, 9] {
             for _ in 0..20 {
-                let elems: Vec<PatchElem> = (0..n_el)
-                    .map(|_| {
-                        let mut x = base;
-                        for p in x.iter_mut() {
-                            for c in p.iter_mut() {
-                                *c += rng.random_range(-0.03..0.03);
-                            }
-                        }
-                        let var = std::array::from_fn(|k| {
-                            if k == 3 || k >= 6 {
-                                (k % 4) as u32
-                            } else {
-                                FIXED
-                            }
-                        });
-                        PatchElem::new(x, var)
-                    })
-                    .collect();
-                let mut v: Vec<f64> = (0..12).map(|_| rng.random_range(-0.01..0.01)).collect();
-                v[9..12].copy_from_slice(&base[3]);
+                let (elems, v) = shaken_patch(&mut rng, n_el);
                 let obj = Objective {
                     elems: &elems,
                     eps: rng.random_range(-0.5..0.1),
@@ -525,9 +531,8 @@ mod tests {
 
     #[test]
     fn parallel_parts_give_the_serial_result_bit_for_bit() {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let mut rng = rand::rngs::StdRng::seed_from_u64(17);
-        let base = curved_tet();
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .build()
@@ -535,24 +540,7 @@ mod tests {
         for (n_el, eps) in [(137usize, -10.0), (64, -10.0), (137, 0.97)] {
             // Elements sharing the four variables (so that the order in which gradients
             // are added matters to the last bit).
-            let elems: Vec<PatchElem> = (0..n_el)
-                .map(|_| {
-                    let mut x = base;
-                    for c in x.iter_mut().flatten() {
-                        *c += rng.random_range(-0.03..0.03);
-                    }
-                    let var = std::array::from_fn(|k| {
-                        if k == 3 || k >= 6 {
-                            (k % 4) as u32
-                        } else {
-                            FIXED
-                        }
-                    });
-                    PatchElem::new(x, var)
-                })
-                .collect();
-            let mut v: Vec<f64> = (0..12).map(|_| rng.random_range(-0.01..0.01)).collect();
-            v[9..12].copy_from_slice(&base[3]);
+            let (elems, v) = shaken_patch(&mut rng, n_el);
             let run = |lone: bool| {
                 pool.install(|| {
                     assert!(parallel_parts(n_el) == 2);
