@@ -209,24 +209,43 @@ pub(super) fn min_measure(b: &[f64; 20], delta: f64) -> f64 {
 impl Objective<'_> {
     /// Smallest measure over the patch at `v`, and the smallest uncertified-but-safe
     /// ratio min b / max b (a lower bound of every element's min J / max J when positive).
+    /// In parallel parts when the patch runs alone, as [`Objective::eval`].
     pub fn min_measure(&self, v: &[f64]) -> (f64, f64) {
-        let mut lo = f64::INFINITY;
-        let mut ratio = f64::INFINITY;
-        let mut xs = [[[0.0; 3]; 10]; L];
-        for chunk in self.elems.chunks(L) {
-            gather(chunk, v, &mut xs);
-            let bs = lanes::bezier_block(&xs);
-            for (e, b) in chunk.iter().zip(&bs) {
-                lo = lo.min(min_measure(b, e.delta));
-                let (mut bmin, mut bmax) = (f64::INFINITY, f64::NEG_INFINITY);
-                for &x in b {
-                    bmin = bmin.min(x);
-                    bmax = bmax.max(x);
+        // (min measure, min ratio) of the elements `elems`.
+        let part = |elems: &[PatchElem]| {
+            let mut lo = f64::INFINITY;
+            let mut ratio = f64::INFINITY;
+            let mut xs = [[[0.0; 3]; 10]; L];
+            for chunk in elems.chunks(L) {
+                gather(chunk, v, &mut xs);
+                let bs = lanes::bezier_block(&xs);
+                for (e, b) in chunk.iter().zip(&bs) {
+                    lo = lo.min(min_measure(b, e.delta));
+                    let (mut bmin, mut bmax) = (f64::INFINITY, f64::NEG_INFINITY);
+                    for &x in b {
+                        bmin = bmin.min(x);
+                        bmax = bmax.max(x);
+                    }
+                    ratio = ratio.min(if bmax > 0.0 { bmin / bmax } else { -1.0 });
                 }
-                ratio = ratio.min(if bmax > 0.0 { bmin / bmax } else { -1.0 });
             }
+            (lo, ratio)
+        };
+        let parts = if (self.lone)() {
+            parallel_parts(self.elems.len())
+        } else {
+            1
+        };
+        if parts > 1 {
+            // Minima: the same whatever the split.
+            let per = self.elems.len().div_ceil(L).div_ceil(parts) * L;
+            self.elems.par_chunks(per).map(part).reduce(
+                || (f64::INFINITY, f64::INFINITY),
+                |a, b| (a.0.min(b.0), a.1.min(b.1)),
+            )
+        } else {
+            part(self.elems)
         }
-        (lo, ratio)
     }
 
     /// Objective at `v`, gradient into `g`. Elements go through [`lanes::eval_block`]
