@@ -4,9 +4,9 @@
 //! a local size ([`corner_sizes`]: the mean length of its edges, or on a surface of
 //! elongated triangles the edge of the equilateral triangle of their mean area), limited
 //! along the surface so neighbours differ by at most the gradation rate, and the field
-//! at a point x is `min_i (h_i + g |x - x_i|)` over the nearest surface vertices, capped at the largest
-//! boundary size. So the interior never gets coarser than the coarsest boundary triangle
-//! and sizes change by at most a factor (1 + g) per element.
+//! at a point x is `min_i (h_i + g |x - x_i|)` over the nearest surface vertices,
+//! capped at the largest boundary size. So the interior never gets coarser than the
+//! coarsest boundary triangle and sizes change by at most a factor (1 + g) per element.
 //!
 //! Deep inside, where every vertex is so far that even the smallest boundary size plus
 //! g times the distance reaches the cap, the field is the cap whichever vertices are

@@ -379,7 +379,7 @@ fn length_scales(elems: &[PatchElem], n_free: usize) -> Vec<f64> {
 
 /// Scores of `elems` at `v`, their minimum and (when `with_skew`, else 0) the largest
 /// corner skewness. In parallel parts when the patch runs `lone` (see
-/// [`objective::parallel_parts`]); the result is the same.
+/// [`objective::part_len`]); the result is the same.
 fn evaluate(
     elems: &[PatchElem],
     v: &[f64],
@@ -409,18 +409,12 @@ fn evaluate(
         }
     };
     let mut res = vec![(0.0, 0.0); elems.len()];
-    let parts = if lone() {
-        objective::parallel_parts(elems.len())
-    } else {
-        1
-    };
-    if parts > 1 {
-        let per = elems.len().div_ceil(L).div_ceil(parts) * L;
-        res.par_chunks_mut(per)
+    match objective::part_len(elems.len(), lone) {
+        Some(per) => res
+            .par_chunks_mut(per)
             .zip(elems.par_chunks(per))
-            .for_each(|(o, e)| score(e, o));
-    } else {
-        score(elems, &mut res);
+            .for_each(|(o, e)| score(e, o)),
+        None => score(elems, &mut res),
     }
     out.clear();
     out.extend(res.iter().map(|r| r.0));
@@ -619,13 +613,8 @@ mod tests {
             [0.0, 0.0, 1.0],
         ]);
         let twice = unit.map(|p| p.map(|c| 2.0 * c));
-        let mean = |x: &[P3; 10]| {
-            crate::geom::shape::TET10_EDGES
-                .iter()
-                .map(|&[a, b]| dist(x[a], x[b]))
-                .sum::<f64>()
-                / 6.0
-        };
+        // Edges 1, 1, 1, √2, √2, √2 (and twice those).
+        let unit_mean = (3.0 + 3.0 * 2f64.sqrt()) / 6.0;
         // Variable 0 (a mid node) in both elements, variable 1 (a corner) in the second.
         let mut va = [FIXED; 10];
         va[4] = 0;
@@ -635,12 +624,11 @@ mod tests {
         let elems = [PatchElem::new(unit, va), PatchElem::new(twice, vb)];
         let s = length_scales(&elems, 2);
         assert_eq!(s.len(), 6);
-        let both = (mean(&unit) + mean(&twice)) / 2.0;
         for d in 0..3 {
-            assert!((s[d] - both).abs() < 1e-15);
-            assert!((s[3 + d] - mean(&twice)).abs() < 1e-15);
+            // Mean of the two elements' means; the second's alone.
+            assert!((s[d] - 1.5 * unit_mean).abs() < 1e-15, "{s:?}");
+            assert!((s[3 + d] - 2.0 * unit_mean).abs() < 1e-15, "{s:?}");
         }
-        assert!((mean(&twice) - 2.0 * mean(&unit)).abs() < 1e-15);
     }
 
     #[test]

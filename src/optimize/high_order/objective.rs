@@ -231,26 +231,19 @@ impl Objective<'_> {
             }
             (lo, ratio)
         };
-        let parts = if (self.lone)() {
-            parallel_parts(self.elems.len())
-        } else {
-            1
-        };
-        if parts > 1 {
+        match part_len(self.elems.len(), self.lone) {
             // Minima: the same whatever the split.
-            let per = self.elems.len().div_ceil(L).div_ceil(parts) * L;
-            self.elems.par_chunks(per).map(part).reduce(
+            Some(per) => self.elems.par_chunks(per).map(part).reduce(
                 || (f64::INFINITY, f64::INFINITY),
                 |a, b| (a.0.min(b.0), a.1.min(b.1)),
-            )
-        } else {
-            part(self.elems)
+            ),
+            None => part(self.elems),
         }
     }
 
     /// Objective at `v`, gradient into `g`. Elements go through [`lanes::eval_block`]
     /// [`L`] at a time (bit-identical to one at a time; tested). A large patch has its
-    /// blocks evaluated in parallel ([`parallel_parts`]); their sums and gradients are
+    /// blocks evaluated in parallel ([`part_len`]); their sums and gradients are
     /// still added in element order, so the result does not depend on the thread count.
     pub fn eval(&self, v: &[f64], g: &mut [f64]) -> f64 {
         g.iter_mut().for_each(|x| *x = 0.0);
@@ -259,17 +252,11 @@ impl Objective<'_> {
         let mut total = 0.0;
         let mut ratio = f64::INFINITY;
         self.last_ratio.set(f64::NEG_INFINITY);
-        let parts = if (self.lone)() {
-            parallel_parts(self.elems.len())
-        } else {
-            1
-        };
-        if parts > 1 {
+        if let Some(per) = part_len(self.elems.len(), self.lone) {
             let mut outs = self.outs.borrow_mut();
             outs.resize_with(self.elems.len().div_ceil(L), Default::default);
-            let per = outs.len().div_ceil(parts);
-            outs.par_chunks_mut(per)
-                .zip(self.elems.par_chunks(per * L))
+            outs.par_chunks_mut(per / L)
+                .zip(self.elems.par_chunks(per))
                 .for_each(|(outs, elems)| {
                     for (out, chunk) in outs.iter_mut().zip(elems.chunks(L)) {
                         eval_chunk(chunk, v, eps, lden, out);
@@ -294,15 +281,21 @@ impl Objective<'_> {
     }
 }
 
-/// Into how many parts to split the evaluation of `n` elements: one per thread of the
-/// current rayon pool, each of at least [`PART_ELEMS`] elements (below that, the hand-off
-/// costs more than it saves). Only for a patch running alone: a thread waiting for its
-/// part to come back steals other work, and another patch would hold it far longer.
-pub(super) fn parallel_parts(n: usize) -> usize {
-    (n / PART_ELEMS).min(rayon::current_num_threads()).max(1)
+/// How many elements (a multiple of [`L`]) each part gets when the evaluation of `n`
+/// elements is split across the current rayon pool, or `None` to evaluate them in one
+/// piece: one part per thread, each of at least [`PART_ELEMS`] elements (below that, the
+/// hand-off costs more than it saves), and only for a patch running alone (`lone()`): a
+/// thread waiting for its part to come back steals other work, and another patch would
+/// hold it far longer. The results never depend on the split.
+pub(super) fn part_len(n: usize, lone: &dyn Fn() -> bool) -> Option<usize> {
+    if !lone() {
+        return None;
+    }
+    let parts = (n / PART_ELEMS).min(rayon::current_num_threads());
+    (parts > 1).then(|| n.div_ceil(L).div_ceil(parts) * L)
 }
 
-/// See [`parallel_parts`].
+/// See [`part_len`].
 const PART_ELEMS: usize = 32;
 
 /// [`lanes::eval_block`] on the elements of `chunk` (at most [`L`]) at `v`, with the
@@ -562,7 +555,10 @@ mod tests {
             let (elems, v) = shaken_patch(&mut rng, n_el);
             let run = |lone: bool| {
                 pool.install(|| {
-                    assert!(parallel_parts(n_el) == 2);
+                    // Split in two for a lone patch only.
+                    let per = part_len(n_el, &|| true).expect("split");
+                    assert!(per % L == 0 && per < n_el && 2 * per >= n_el, "{per}");
+                    assert_eq!(part_len(n_el, &|| false), None);
                     let yes = || lone;
                     let obj = Objective {
                         elems: &elems,
