@@ -34,8 +34,12 @@ for p in "$libdir"/plugins/*.so; do
   ln -s "$p" "$root/$rel/plugins/"
 done
 ln -s "$PLUGIN" "$root/$rel/plugins/"
+# The X authority file lives in $work: without -f, xvfb-run makes a temporary folder of its
+# own and, when removing it fails, ends with its exit code 5 instead of meshlabserver's
+# (seen once in CI, on the open-surface case).
 server() {
-  "$XVFB_RUN" -a -e "$work/xvfb.log" "$root/bin/meshlabserver" "$@"
+  : >"$work/Xauthority"
+  "$XVFB_RUN" -a -f "$work/Xauthority" -e "$work/xvfb.log" "$root/bin/meshlabserver" "$@"
 }
 
 filter='Tetrahedralize: curved quadratic (curvetet)'
