@@ -241,25 +241,38 @@ fn generate_inner(
     })
 }
 
-/// A front failure on a surface with poorly shaped triangles says so, and what helps.
+/// A front failure on a surface with poorly shaped or mostly elongated triangles says so,
+/// and what helps.
 fn with_shape_hint(e: Error, s: &Surface) -> Error {
+    use crate::surface::geometry::{
+        median_aspect_ratio, poorly_shaped, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
+    };
     let Error::MeshingFailed { msg, partial } = e else {
         return e;
     };
-    let (poor, worst) = crate::surface::geometry::poorly_shaped(s.nodes(), s.triangles());
-    if poor == 0 {
-        return Error::MeshingFailed { msg, partial };
-    }
-    Error::MeshingFailed {
-        msg: format!(
-            "{msg}. Note: {poor} of {} boundary triangles are poorly shaped (aspect ratio above \
-             {}, worst {worst:.0}); the front needs well-shaped boundary \
+    let (poor, worst) = poorly_shaped(s.nodes(), s.triangles());
+    let median = median_aspect_ratio(s.nodes(), s.triangles());
+    let note = if poor > 0 {
+        format!(
+            "{poor} of {} boundary triangles are poorly shaped (aspect ratio above \
+             {POOR_ASPECT_RATIO}, worst {worst:.0}); the front needs well-shaped boundary \
              triangles: smooth a surface from image segmentation before curving (CLI \
              `--smooth 10`, `CurveOptions::smooth_iterations`, C \
              `curvetet_surface_from_linear_smoothed`) or remesh it",
             s.triangles().len(),
-            crate::surface::geometry::POOR_ASPECT_RATIO
-        ),
+        )
+    } else if median > ELONGATED_MEDIAN_ASPECT_RATIO {
+        format!(
+            "most boundary triangles are elongated (median aspect ratio {median:.1}, above \
+             {ELONGATED_MEDIAN_ASPECT_RATIO}; worst {worst:.1}), and the front gets stuck \
+             where long boundary edges meet short ones: remesh the surface with more \
+             isotropic triangles"
+        )
+    } else {
+        return Error::MeshingFailed { msg, partial };
+    };
+    Error::MeshingFailed {
+        msg: format!("{msg}. Note: {note}"),
         partial,
     }
 }
@@ -377,6 +390,36 @@ mod tests {
         assert_eq!(msg, "stuck");
         let e = with_shape_hint(Error::Cancelled, &mc_blob(0));
         assert!(matches!(e, Error::Cancelled));
+    }
+
+    #[test]
+    fn a_stuck_front_on_elongated_triangles_says_so() {
+        let failed = || Error::MeshingFailed {
+            msg: "stuck".into(),
+            partial: None,
+        };
+        let surface = |nu, nv| {
+            let (nodes, tris) = crate::surface::demo::torus(nu, nv, 1.0, 0.35);
+            let n = tris.len();
+            Surface::new(nodes, tris, vec![0; n]).expect("a valid torus")
+        };
+        // 25 x 54 (scripts/aniso-torus.py's, exactly curved): every triangle about 3.6
+        // (aspect ratio below 10, so not "poorly shaped").
+        let Error::MeshingFailed { msg, .. } = with_shape_hint(failed(), &surface(25, 54)) else {
+            panic!("not a meshing failure");
+        };
+        assert!(
+            msg.starts_with(
+                "stuck. Note: most boundary triangles are elongated (median aspect ratio 3."
+            ),
+            "{msg}"
+        );
+        assert!(msg.contains("remesh the surface"), "{msg}");
+        // 50 x 54: median 2.0, the message is left alone.
+        let Error::MeshingFailed { msg, .. } = with_shape_hint(failed(), &surface(50, 54)) else {
+            panic!("not a meshing failure");
+        };
+        assert_eq!(msg, "stuck");
     }
 
     /// The corner qualities the front hands to the linear stage are, bit for bit, what

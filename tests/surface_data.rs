@@ -92,3 +92,22 @@ fn poorly_shaped_surfaces_warn() {
     );
     assert!(surface(10).warnings().is_empty());
 }
+
+/// A surface of mostly elongated triangles warns (a 25 × 54 torus, the triangles of
+/// `scripts/aniso-torus.py 25 54`: median aspect ratio 3.6, none above 10); a 50 × 54 one
+/// (median 2.0) does not.
+#[test]
+fn elongated_surfaces_warn() {
+    let surface = |nu, nv| {
+        let (nodes, tris) = curvetet::surface::demo::torus(nu, nv, 1.0, 0.35);
+        let n = tris.len();
+        curvetet::Surface::new(nodes, tris, vec![0; n]).expect("a valid torus")
+    };
+    let w = surface(25, 54).warnings().to_vec();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("most triangles are elongated (median aspect ratio 3.6, above 3.3)"),
+        "{w:?}"
+    );
+    assert!(surface(50, 54).warnings().is_empty());
+}

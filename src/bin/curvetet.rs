@@ -7,6 +7,9 @@ use curvetet::io::{self, MshVersion, WriteOptions};
 use curvetet::mesh::quality::QualityReport;
 use curvetet::mesh::{check, TetMesh};
 use curvetet::surface::curve::{curve_linear_report, CurveOptions, CurveReport};
+use curvetet::surface::geometry::{
+    median_aspect_ratio, poorly_shaped, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
+};
 use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -557,23 +560,27 @@ fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Er
     Ok(())
 }
 
-/// The corner triangles' shape: how many are poorly shaped for the front, the worst.
+/// The corner triangles' shape: how many are poorly shaped for the front, the worst, the
+/// median (elongated triangles above [`ELONGATED_MEDIAN_ASPECT_RATIO`]).
 fn shape_json(s: &Surface) -> serde_json::Value {
-    let (poor, worst) = curvetet::surface::geometry::poorly_shaped(s.nodes(), s.triangles());
+    let (poor, worst) = poorly_shaped(s.nodes(), s.triangles());
     serde_json::json!({
-        "poor_aspect_ratio": curvetet::surface::geometry::POOR_ASPECT_RATIO,
+        "poor_aspect_ratio": POOR_ASPECT_RATIO,
         "poorly_shaped": poor,
         "worst_aspect_ratio": worst,
+        "median_aspect_ratio": median_aspect_ratio(s.nodes(), s.triangles()),
+        "elongated_median_aspect_ratio": ELONGATED_MEDIAN_ASPECT_RATIO,
     })
 }
 
 /// [`shape_json`] as a line of `check`'s text report.
 fn shape_line(s: &Surface) -> String {
-    let (poor, worst) = curvetet::surface::geometry::poorly_shaped(s.nodes(), s.triangles());
+    let (poor, worst) = poorly_shaped(s.nodes(), s.triangles());
     format!(
-        "triangle aspect ratio: worst {worst:.2}, {poor} of {} above {}",
+        "triangle aspect ratio: worst {worst:.2}, median {:.2}, {poor} of {} above {}",
+        median_aspect_ratio(s.nodes(), s.triangles()),
         s.triangles().len(),
-        curvetet::surface::geometry::POOR_ASPECT_RATIO
+        POOR_ASPECT_RATIO
     )
 }
 

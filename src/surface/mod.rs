@@ -147,6 +147,15 @@ impl Surface {
                 geometry::POOR_ASPECT_RATIO
             ));
         }
+        let median = geometry::median_aspect_ratio(&nodes, &tris);
+        if median > geometry::ELONGATED_MEDIAN_ASPECT_RATIO {
+            warnings.push(format!(
+                "most triangles are elongated (median aspect ratio {median:.1}, above {}): the \
+                 advancing front may not close on them; remesh the surface with more \
+                 isotropic triangles",
+                geometry::ELONGATED_MEDIAN_ASPECT_RATIO
+            ));
+        }
         Ok(Surface {
             nodes,
             tris,
