@@ -245,13 +245,13 @@ fn generate_inner(
 /// and what helps.
 fn with_shape_hint(e: Error, s: &Surface) -> Error {
     use crate::surface::geometry::{
-        median_aspect_ratio, poorly_shaped, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
+        triangle_shape, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
     };
     let Error::MeshingFailed { msg, partial } = e else {
         return e;
     };
-    let (poor, worst) = poorly_shaped(s.nodes(), s.triangles());
-    let median = median_aspect_ratio(s.nodes(), s.triangles());
+    let shape = triangle_shape(s.nodes(), s.triangles());
+    let (poor, worst, median) = (shape.poor, shape.worst, shape.median);
     let note = if poor > 0 {
         format!(
             "{poor} of {} boundary triangles are poorly shaped (aspect ratio above \
@@ -261,7 +261,7 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
              `curvetet_surface_from_linear_smoothed`) or remesh it",
             s.triangles().len(),
         )
-    } else if median > ELONGATED_MEDIAN_ASPECT_RATIO {
+    } else if shape.elongated() {
         format!(
             "most boundary triangles are elongated (median aspect ratio {median:.1}, above \
              {ELONGATED_MEDIAN_ASPECT_RATIO}; worst {worst:.1}), and the front gets stuck \

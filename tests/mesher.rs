@@ -176,7 +176,7 @@ fn elongated_triangles_sized_from_areas() {
 
 /// Largest aspect ratio of the surface's corner triangles.
 fn worst_aspect(s: &curvetet::Surface) -> f64 {
-    curvetet::surface::geometry::poorly_shaped(s.nodes(), s.triangles()).1
+    curvetet::surface::geometry::triangle_shape(s.nodes(), s.triangles()).worst
 }
 
 /// A raw marching-cubes surface (`scripts/marching-cubes.py 22 blob`, 2,316 triangles,

@@ -8,7 +8,7 @@ use curvetet::mesh::quality::QualityReport;
 use curvetet::mesh::{check, TetMesh};
 use curvetet::surface::curve::{curve_linear_report, CurveOptions, CurveReport};
 use curvetet::surface::geometry::{
-    median_aspect_ratio, poorly_shaped, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
+    triangle_shape, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
 };
 use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -563,24 +563,25 @@ fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Er
 /// The corner triangles' shape: how many are poorly shaped for the front, the worst, the
 /// median (elongated triangles above [`ELONGATED_MEDIAN_ASPECT_RATIO`]).
 fn shape_json(s: &Surface) -> serde_json::Value {
-    let (poor, worst) = poorly_shaped(s.nodes(), s.triangles());
+    let shape = triangle_shape(s.nodes(), s.triangles());
     serde_json::json!({
         "poor_aspect_ratio": POOR_ASPECT_RATIO,
-        "poorly_shaped": poor,
-        "worst_aspect_ratio": worst,
-        "median_aspect_ratio": median_aspect_ratio(s.nodes(), s.triangles()),
+        "poorly_shaped": shape.poor,
+        "worst_aspect_ratio": shape.worst,
+        "median_aspect_ratio": shape.median,
         "elongated_median_aspect_ratio": ELONGATED_MEDIAN_ASPECT_RATIO,
     })
 }
 
 /// [`shape_json`] as a line of `check`'s text report.
 fn shape_line(s: &Surface) -> String {
-    let (poor, worst) = poorly_shaped(s.nodes(), s.triangles());
+    let shape = triangle_shape(s.nodes(), s.triangles());
     format!(
-        "triangle aspect ratio: worst {worst:.2}, median {:.2}, {poor} of {} above {}",
-        median_aspect_ratio(s.nodes(), s.triangles()),
-        s.triangles().len(),
-        POOR_ASPECT_RATIO
+        "triangle aspect ratio: worst {:.2}, median {:.2}, {} of {} above {POOR_ASPECT_RATIO}",
+        shape.worst,
+        shape.median,
+        shape.poor,
+        s.triangles().len()
     )
 }
 

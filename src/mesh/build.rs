@@ -62,9 +62,11 @@ pub fn assemble(
         for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
             let (a, b) = (c[*i], c[*j]);
             let (lo, hi) = (a.min(b), a.max(b));
-            let boundary = ((hi as usize) < n_surf)
-                .then(|| bedge.get(&(lo, hi)).copied())
-                .flatten();
+            let boundary = if (hi as usize) < n_surf {
+                bedge.get(&(lo, hi)).copied()
+            } else {
+                None
+            };
             x[4 + k] = match boundary {
                 Some(m) => m,
                 None => {

@@ -225,7 +225,7 @@ pub fn aspect_ratio(a: P3, b: P3, c: P3) -> f64 {
     }
 }
 
-/// Surfaces whose median corner-triangle aspect ratio ([`median_aspect_ratio`]) exceeds
+/// Surfaces whose median corner-triangle aspect ratio ([`TriangleShape::median`]) exceeds
 /// this are made of elongated triangles, on which the advancing front may not close:
 /// long boundary edges next to short ones. Tori from `scripts/aniso-torus.py`: 12-25 ×
 /// 27-54 with median 3.5-4.0 left the front stuck (one, 12 × 27 `--no-shift` at 4.3,
@@ -234,9 +234,26 @@ pub fn aspect_ratio(a: P3, b: P3, c: P3) -> f64 {
 /// 1.03-1.21.
 pub const ELONGATED_MEDIAN_ASPECT_RATIO: f64 = 3.3;
 
-/// The median of the corner triangles' aspect ratios ([`aspect_ratio`]); 1 for no
-/// triangle.
-pub fn median_aspect_ratio(nodes: &[P3], tris: &[[u32; 6]]) -> f64 {
+/// The corner triangles' aspect ratios ([`aspect_ratio`]) summed up for the front.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleShape {
+    /// Triangles above [`POOR_ASPECT_RATIO`].
+    pub poor: usize,
+    /// The largest aspect ratio (0 for no triangle).
+    pub worst: f64,
+    /// The median aspect ratio (1 for no triangle); see [`ELONGATED_MEDIAN_ASPECT_RATIO`].
+    pub median: f64,
+}
+
+impl TriangleShape {
+    /// Most triangles elongated: the median above [`ELONGATED_MEDIAN_ASPECT_RATIO`].
+    pub fn elongated(&self) -> bool {
+        self.median > ELONGATED_MEDIAN_ASPECT_RATIO
+    }
+}
+
+/// The [`TriangleShape`] of the corner triangles of `tris`, in one pass over them.
+pub fn triangle_shape(nodes: &[P3], tris: &[[u32; 6]]) -> TriangleShape {
     let mut r: Vec<f64> = tris
         .iter()
         .map(|t| {
@@ -247,29 +264,19 @@ pub fn median_aspect_ratio(nodes: &[P3], tris: &[[u32; 6]]) -> f64 {
             )
         })
         .collect();
-    if r.is_empty() {
-        return 1.0;
+    let poor = r.iter().filter(|&&x| x > POOR_ASPECT_RATIO).count();
+    let worst = r.iter().copied().fold(0.0f64, f64::max);
+    let median = if r.is_empty() {
+        1.0
+    } else {
+        let k = r.len() / 2;
+        *r.select_nth_unstable_by(k, f64::total_cmp).1
+    };
+    TriangleShape {
+        poor,
+        worst,
+        median,
     }
-    let k = r.len() / 2;
-    *r.select_nth_unstable_by(k, f64::total_cmp).1
-}
-
-/// The number of triangles of `tris` whose corner triangle's aspect ratio exceeds
-/// [`POOR_ASPECT_RATIO`], and the largest aspect ratio.
-pub fn poorly_shaped(nodes: &[P3], tris: &[[u32; 6]]) -> (usize, f64) {
-    let (mut poor, mut worst) = (0usize, 0.0f64);
-    for t in tris {
-        let r = aspect_ratio(
-            nodes[t[0] as usize],
-            nodes[t[1] as usize],
-            nodes[t[2] as usize],
-        );
-        if r > POOR_ASPECT_RATIO {
-            poor += 1;
-        }
-        worst = worst.max(r);
-    }
-    (poor, worst)
 }
 
 #[cfg(test)]
@@ -303,10 +310,10 @@ mod tests {
         assert!(got < 0.99);
     }
 
-    /// The median of three triangles' aspect ratios is the middle one; the equilateral
-    /// triangle's is 1.
+    /// Of three triangles' aspect ratios, the median is the middle one and the worst the
+    /// largest; the equilateral triangle's is 1.
     #[test]
-    fn median_aspect_ratio_is_the_middle_one() {
+    fn triangle_shape_has_the_median_and_the_worst() {
         let h = 3f64.sqrt() / 2.0;
         // Equilateral; isosceles of base 1 and height 0.2 and 0.05 (aspect ratio grows as
         // the height shrinks).
@@ -324,8 +331,17 @@ mod tests {
         let thin = aspect_ratio(nodes[0], nodes[1], nodes[4]);
         assert!(1.0 < mid && mid < thin, "{mid} {thin}");
         let tris = [tri(4), tri(2), tri(3)];
-        assert_eq!(median_aspect_ratio(&nodes, &tris), mid);
-        assert_eq!(median_aspect_ratio(&nodes, &tris[1..2]), eq);
-        assert_eq!(median_aspect_ratio(&nodes, &[]), 1.0);
+        let shape = |tris: &[[u32; 6]]| triangle_shape(&nodes, tris);
+        let s = shape(&tris);
+        assert_eq!((s.median, s.worst), (mid, thin));
+        // Only the thinnest is above 10.
+        assert!(
+            thin > POOR_ASPECT_RATIO && mid < POOR_ASPECT_RATIO,
+            "{mid} {thin}"
+        );
+        assert_eq!(s.poor, 1);
+        assert_eq!(shape(&tris[1..2]).median, eq);
+        let none = shape(&[]);
+        assert_eq!((none.poor, none.worst, none.median), (0, 0.0, 1.0));
     }
 }

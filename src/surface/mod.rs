@@ -137,7 +137,8 @@ impl Surface {
             orientation::flip_all(&mut tris, &mut neighbors, &mut edges);
             warnings.push(FLIPPED_WARNING.to_string());
         }
-        let (poor, worst) = geometry::poorly_shaped(&nodes, &tris);
+        let shape = geometry::triangle_shape(&nodes, &tris);
+        let (poor, worst) = (shape.poor, shape.worst);
         if poor * POOR_SHAPE_WARN_ONE_IN > tris.len() {
             warnings.push(format!(
                 "{poor} of {} triangles have an aspect ratio above {} (worst {worst:.0}): the \
@@ -147,12 +148,12 @@ impl Surface {
                 geometry::POOR_ASPECT_RATIO
             ));
         }
-        let median = geometry::median_aspect_ratio(&nodes, &tris);
-        if median > geometry::ELONGATED_MEDIAN_ASPECT_RATIO {
+        if shape.elongated() {
             warnings.push(format!(
-                "most triangles are elongated (median aspect ratio {median:.1}, above {}): the \
+                "most triangles are elongated (median aspect ratio {:.1}, above {}): the \
                  advancing front may not close on them; remesh the surface with more \
                  isotropic triangles",
+                shape.median,
                 geometry::ELONGATED_MEDIAN_ASPECT_RATIO
             ));
         }

@@ -312,9 +312,7 @@ fn run_barrier(
         let obj = &obj;
         let mut f = |u: &[f64], g: &mut [f64]| {
             evals += elems.len() as u64;
-            for ((x, u), s) in v.iter_mut().zip(u).zip(scale) {
-                *x = u * s;
-            }
+            unscale(u, scale, v);
             let val = obj.eval(v, g);
             for (g, s) in g.iter_mut().zip(scale) {
                 *g *= s;
@@ -324,9 +322,8 @@ fn run_barrier(
         let target = prm.threshold + prm.stop_slack;
         let mut reached = || last.get() >= target;
         lb.minimize(&mut u, &mut f, prm.iterations, FIRST_STEP, &mut reached);
-        for ((x, u), s) in v.iter_mut().zip(&u).zip(scale) {
-            *x = u * s;
-        }
+        // (The last evaluation may have been a rejected trial point.)
+        unscale(&u, scale, v);
         let (new, ratio) = obj.min_measure(v);
         let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
         mmin = new;
@@ -335,6 +332,14 @@ fn run_barrier(
         }
     }
     evals
+}
+
+/// The variables `v` of the scaled variables `u` (`v = u * scale`).
+#[inline]
+fn unscale(u: &[f64], scale: &[f64], v: &mut [f64]) {
+    for ((x, u), s) in v.iter_mut().zip(u).zip(scale) {
+        *x = u * s;
+    }
 }
 
 /// Length of the first L-BFGS step of a barrier run, in units of the variables' length

@@ -242,9 +242,10 @@ impl Objective<'_> {
     }
 
     /// Objective at `v`, gradient into `g`. Elements go through [`lanes::eval_block`]
-    /// [`L`] at a time (bit-identical to one at a time; tested). A large patch has its
-    /// blocks evaluated in parallel ([`part_len`]); their sums and gradients are
-    /// still added in element order, so the result does not depend on the thread count.
+    /// [`L`] at a time (bit-identical to one at a time; tested). A patch running alone
+    /// has its blocks evaluated in parallel parts ([`part_len`]); their sums and
+    /// gradients are still added in element order, so the result does not depend on the
+    /// split or the thread count.
     pub fn eval(&self, v: &[f64], g: &mut [f64]) -> f64 {
         g.iter_mut().for_each(|x| *x = 0.0);
         let eps = self.eps;
