@@ -170,7 +170,7 @@ fn generate_inner(
         if opts.optimize {
             let t = Instant::now();
             ostats.high_order =
-                pool.install(|| optimize_high_order(&mut mesh, &bnd, &HighOrderParams::default()));
+                pool.install(|| optimize_high_order(&mut mesh, &bnd, &high_order_params(opts)));
             ostats.time_high_order = t.elapsed().as_secs_f64();
         }
         times.optimize += ostats.time_linear + ostats.time_high_order;
@@ -239,6 +239,15 @@ fn generate_inner(
         size_from: size.measured_from(),
         size: size_value,
     })
+}
+
+/// The high-order stage's tuning for `opts` ([`Options::thorough`]).
+fn high_order_params(opts: &Options) -> HighOrderParams {
+    if opts.thorough {
+        HighOrderParams::thorough()
+    } else {
+        HighOrderParams::default()
+    }
 }
 
 /// A front failure on a surface with poorly shaped or mostly elongated triangles says so,

@@ -51,6 +51,13 @@ pub struct curvetet_options {
     /// the mean curved triangle area, its eq. 1) instead of grading from the boundary.
     /// Default 0. (Added in 0.1 after the first struct; older callers get the default.)
     pub uniform_size: i32,
+    /// Nonzero: more high-order rounds where some element starts poor (CAD parts), for
+    /// fewer elements left between the worst one and min J / max J 0.85, at about three
+    /// times that stage's work there. Default 0. (Added after `uniform_size`, in what
+    /// was its padding: `struct_size` did not grow, so older callers get the default
+    /// through `curvetet_options_default` or `curvetet_options_init`, as every caller
+    /// must initialise.)
+    pub thorough: i32,
 }
 
 /// `sizeof(curvetet_options)` of the first version of the ABI (curvetet 0.1): every
@@ -74,6 +81,7 @@ impl curvetet_options {
             progress: None,
             user_data: std::ptr::null_mut(),
             uniform_size: 0,
+            thorough: d.thorough as i32,
         }
     }
 }
@@ -145,10 +153,12 @@ pub(crate) unsafe fn parse(p: *const curvetet_options) -> Result<Parsed> {
         take!(progress);
         take!(user_data);
         take!(uniform_size);
+        take!(thorough);
     }
     let mut options = Options {
         alpha: o.alpha,
         optimize: o.optimize != 0,
+        thorough: o.thorough != 0,
         threads: o.threads as usize,
         ..Options::default()
     };

@@ -123,14 +123,20 @@ fn options_struct_size_is_checked() {
         unsafe { parse(&u) }.unwrap().options.size,
         SizeMode::Fixed(0.5)
     );
-    // A first-version struct (without uniform_size) is read up to its size only.
+    // thorough is off by default and passed through.
+    assert!(!p.options.thorough);
+    let mut t = o;
+    t.thorough = 1;
+    assert!(unsafe { parse(&t) }.unwrap().options.thorough);
+    // A first-version struct (without uniform_size or thorough) is read up to its size
+    // only.
     let mut v1 = o;
     v1.uniform_size = 1;
+    v1.thorough = 1;
     v1.struct_size = OPTIONS_SIZE_V1 as u32;
-    assert_eq!(
-        unsafe { parse(&v1) }.unwrap().options.size,
-        SizeMode::Graded
-    );
+    let p1 = unsafe { parse(&v1) }.unwrap().options;
+    assert_eq!(p1.size, SizeMode::Graded);
+    assert!(!p1.thorough);
     assert!(unsafe { parse(null()) }.is_ok());
 
     for bad in [
