@@ -724,6 +724,48 @@ mod tests {
     }
 
     #[test]
+    fn rounds_go_on_while_an_element_is_invalid() {
+        let c = cube(3, 0.05);
+        let bnd = c.boundary();
+        let mut m = c.p2();
+        let n = central_mid(&m, c.n_surf) as usize;
+        m.nodes[n][0] += 0.25;
+        m.nodes[n][1] -= 0.15;
+        assert!(
+            !uncertified(&m).is_empty(),
+            "the test needs invalid elements"
+        );
+        // The tangle starts poor (below reach_below): the staged rounds apply. With none
+        // planned, only invalid elements keep rounds going, and they stop once all are
+        // valid.
+        let only_invalid = HighOrderParams {
+            rounds: 0,
+            ..HighOrderParams::default()
+        };
+        let mut a = m.clone();
+        let st = optimize_high_order(&mut a, &bnd, &only_invalid);
+        assert!(
+            st.min_scaled_jacobian[0] < only_invalid.reach_below,
+            "{st:?}"
+        );
+        assert!(
+            st.rounds >= 1 && st.rounds <= only_invalid.rounds_while_invalid,
+            "{st:?}"
+        );
+        assert!(uncertified(&a).is_empty(), "{st:?}");
+        // Without the extension nothing runs.
+        let none = HighOrderParams {
+            rounds: 0,
+            rounds_while_invalid: 0,
+            ..HighOrderParams::default()
+        };
+        let mut b = m.clone();
+        let st = optimize_high_order(&mut b, &bnd, &none);
+        assert_eq!(st.rounds, 0);
+        assert!(!uncertified(&b).is_empty());
+    }
+
+    #[test]
     fn same_result_for_one_two_and_four_threads() {
         let c = cube(4, 0.08);
         let bnd = c.boundary();
