@@ -51,6 +51,8 @@ class _Options(ctypes.Structure):
         ("threads", ctypes.c_uint32),
         ("progress", _PROGRESS),
         ("user_data", ctypes.c_void_p),
+        ("uniform_size", ctypes.c_int32),
+        ("thorough", ctypes.c_int32),
     ]
 
 
@@ -308,7 +310,7 @@ def _mesh_volume(lib, volume, coords, opt):
         lib.curvetet_surface_free(surface)
 
 
-def generate(alpha=1.5, optimize=True, size=0.0, threads=0, progress=None):
+def generate(alpha=1.5, optimize=True, size=0.0, threads=0, progress=None, thorough=False):
     """Mesh every volume entity of the current Gmsh model with curvetet.
 
     The model needs a second-order surface mesh (6-node triangles, type 9) on the boundary
@@ -321,7 +323,9 @@ def generate(alpha=1.5, optimize=True, size=0.0, threads=0, progress=None):
     alpha: search radius factor (paper's 1.5); optimize: quality improvement and
     high-order optimization; size: target edge length (<= 0: graded from the boundary);
     threads: worker threads (0: all cores); progress: optional callable(fraction, stage)
-    returning True to cancel.
+    returning True to cancel; thorough: more high-order rounds where some element starts
+    poor (CAD parts), about three times that stage's work there, for fewer elements left
+    between the worst one and min J / max J 0.85.
 
     Raises CurvetetError with curvetet's message when a volume cannot be meshed; every
     volume is meshed before the model is touched, so the model is then unchanged.
@@ -334,6 +338,7 @@ def generate(alpha=1.5, optimize=True, size=0.0, threads=0, progress=None):
     opt.alpha = float(alpha)
     opt.size = float(size)
     opt.optimize = 1 if optimize else 0
+    opt.thorough = 1 if thorough else 0
     opt.threads = int(threads)
     raised = []
     if progress is not None:

@@ -158,6 +158,7 @@ vtkCurveTetFilter::vtkCurveTetFilter()
   , Size(0.0)
   , UniformSize(0)
   , Optimize(1)
+  , Thorough(0)
   , FeatureAngle(40.0)
   , SmoothIterations(0)
   , NumberOfThreads(0)
@@ -265,6 +266,7 @@ int vtkCurveTetFilter::RequestData(
   opt.size = this->Size;
   opt.uniform_size = this->UniformSize ? 1 : 0;
   opt.optimize = this->Optimize ? 1 : 0;
+  opt.thorough = this->Thorough ? 1 : 0;
   opt.threads = static_cast<uint32_t>(std::max(0, this->NumberOfThreads));
   opt.progress = &vtkCurveTetFilter::ProgressCallback;
   opt.user_data = this;
@@ -338,6 +340,7 @@ void vtkCurveTetFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Size: " << this->Size << "\n";
   os << indent << "UniformSize: " << this->UniformSize << "\n";
   os << indent << "Optimize: " << this->Optimize << "\n";
+  os << indent << "Thorough: " << this->Thorough << "\n";
   os << indent << "FeatureAngle: " << this->FeatureAngle << "\n";
   os << indent << "SmoothIterations: " << this->SmoothIterations << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";

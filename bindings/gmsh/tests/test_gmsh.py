@@ -268,6 +268,30 @@ class TestFailures(GmshCase):
         self.assertEqual(count_elements(), n)
 
 
+class TestOptions(GmshCase):
+    def test_options_struct_is_the_headers(self):
+        # curvetet_options_default writes this library's sizeof(curvetet_options) into
+        # struct_size: the Python mirror must have every field of the header.
+        import ctypes
+        lib = curvetet_gmsh._load()
+        buf = ctypes.create_string_buffer(4096)
+        lib.curvetet_options_default.argtypes = [ctypes.c_void_p]
+        lib.curvetet_options_default.restype = None
+        lib.curvetet_options_default(buf)
+        size = struct.unpack_from("I", buf.raw, 0)[0]
+        self.assertEqual(size, ctypes.sizeof(curvetet_gmsh._Options))
+        opt = curvetet_gmsh._Options.from_buffer_copy(buf.raw[:size])
+        self.assertEqual((opt.optimize, opt.uniform_size, opt.thorough), (1, 0, 0))
+
+    def test_thorough_meshes(self):
+        gmsh.model.occ.addSphere(0, 0, 0, 1)
+        gmsh.model.occ.synchronize()
+        self.surface_mesh_order2(0.3)
+        tris = surface_triangles()
+        curvetet_gmsh.generate(thorough=True)
+        self.check_volume_mesh(tris)
+
+
 if __name__ == "__main__":
     print("libcurvetet:", curvetet_gmsh.library_path(), "version", curvetet_gmsh.version())
     unittest.main()

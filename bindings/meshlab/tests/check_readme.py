@@ -19,7 +19,7 @@ for needle in [
     "meshlabserver",
     "xvfb-run",
     "bindings/meshlab/LICENSE.md",
-    "alpha", "featureAngle", "smoothIterations", "optimize", "outputFile",
+    "alpha", "featureAngle", "smoothIterations", "optimize", "thorough", "outputFile",
 ]:
     assert needle in section, f"README's MeshLab section lacks {needle!r}"
 print("README: the MeshLab section names the filter, the build, the install and the GUI steps")

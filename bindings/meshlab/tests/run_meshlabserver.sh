@@ -56,6 +56,7 @@ write_mlx() { # write_mlx FILE OUTPUT...: the filter once per output file
   <Param type="RichFloat" name="featureAngle" value="40" description="Feature angle (degrees)"/>
   <Param type="RichInt" name="smoothIterations" value="${SMOOTH:-0}" description="Smoothing iterations"/>
   <Param type="RichBool" name="optimize" value="true" description="Optimize"/>
+  <Param type="RichBool" name="thorough" value="false" description="Thorough"/>
   <Param type="RichSaveFile" name="outputFile" value="$out" ext=".msh" description="Output file (.msh or .vtu)"/>
  </filter>
 MLX
@@ -68,10 +69,11 @@ case "$mode" in
 dump)
   server -d "$work/dump.txt" >"$work/log.txt" 2>&1 || { cat "$work/log.txt" >&2; fail "meshlabserver -d"; }
   grep -F "$filter" "$work/dump.txt" || fail "the filter is not listed by meshlabserver -d"
-  # Its section (up to the next filter's) lists the five parameters: type and label.
+  # Its section (up to the next filter's) lists the six parameters: type and label.
   sed -n "/\\\\section f[0-9]* $filter/,/^\\\\section/p" "$work/dump.txt" >"$work/section.txt"
   for row in "Float .*Search radius factor" "Float .*Feature angle (degrees)" \
-             "Int .*Smoothing iterations" "Bool .*Optimize" "FileName .*Output file (.msh or .vtu)"; do
+             "Int .*Smoothing iterations" "Bool .*Optimize" "Bool .*Thorough" \
+             "FileName .*Output file (.msh or .vtu)"; do
     grep -q "$row" "$work/section.txt" || fail "parameter '$row' not listed"
   done
   echo "meshlabserver -d lists '$filter' with its parameters"

@@ -17,6 +17,9 @@
 //       the next update runs to the end.
 //   TestCurveTetFilter smooth SURFACE.off
 //       a raw marching-cubes surface with SmoothIterations 10: it meshes, its vertices moved.
+//   TestCurveTetFilter thorough SURFACE.off
+//       a surface whose mesh starts poor (hinge_lin.off): with Thorough on, fewer cells end
+//       below ScaledJacobian 0.85 than with the default.
 #include "vtkCurveTetFilter.h"
 
 #include <curvetet.h>
@@ -48,6 +51,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -727,13 +731,56 @@ void TestSmooth(const std::string& off)
     static_cast<long long>(out->GetNumberOfCells()), static_cast<long long>(moved),
     static_cast<long long>(in->GetNumberOfPoints()));
 }
+
+// Cells of `grid` whose ScaledJacobian cell value is below `below`, and the smallest value.
+std::pair<vtkIdType, double> CountBelow(vtkUnstructuredGrid* grid, double below)
+{
+  vtkDataArray* sj = grid->GetCellData()->GetArray("ScaledJacobian");
+  CHECK(sj != nullptr);
+  if (sj == nullptr)
+    return { 0, -1.0 };
+  vtkIdType n = 0;
+  double lo = 1.0;
+  for (vtkIdType c = 0; c < sj->GetNumberOfTuples(); ++c)
+  {
+    const double v = sj->GetComponent(c, 0);
+    n += v < below ? 1 : 0;
+    lo = std::min(lo, v);
+  }
+  return { n, lo };
+}
+
+void TestThorough(const std::string& off)
+{
+  vtkSmartPointer<vtkPolyData> in = ReadOff(off);
+  vtkNew<vtkCurveTetFilter> filter;
+  filter->SetInputData(in);
+  Messages msgs;
+  msgs.Watch(filter);
+  filter->Update();
+  CHECK(msgs.errors == 0);
+  const auto quick = CountBelow(filter->GetOutput(0), 0.85);
+  CHECK(filter->GetThorough() == 0);
+  filter->ThoroughOn();
+  std::ostringstream printed;
+  filter->Print(printed);
+  CHECK(printed.str().find("Thorough: 1") != std::string::npos);
+  filter->Update();
+  CHECK(msgs.errors == 0);
+  const auto thorough = CountBelow(filter->GetOutput(0), 0.85);
+  CHECK(thorough.first < quick.first);
+  CHECK(quick.second > 0.35 && thorough.second > 0.35);
+  std::printf("  cells below ScaledJacobian 0.85: default %lld (min %.3f), thorough %lld (min %.3f)\n",
+    static_cast<long long>(quick.first), quick.second, static_cast<long long>(thorough.first),
+    thorough.second);
+}
 } // namespace
 
 int main(int argc, char* argv[])
 {
   if (argc < 3)
   {
-    std::fprintf(stderr, "usage: %s pipeline|p2|bad|abort|smooth FILE [OUTDIR]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s pipeline|p2|bad|abort|smooth|thorough FILE [OUTDIR]\n", argv[0]);
     return 2;
   }
   const std::string mode = argv[1], file = argv[2];
@@ -748,6 +795,8 @@ int main(int argc, char* argv[])
     TestAbort(file);
   else if (mode == "smooth")
     TestSmooth(file);
+  else if (mode == "thorough")
+    TestThorough(file);
   else if (mode == "off2stl" && argc >= 4)
     CHECK(OffToStl(file, argv[3]));
   else
