@@ -701,16 +701,25 @@ mod tests {
         }
     }
 
-    #[test]
-    fn untangles_an_invalid_patch_and_keeps_the_boundary() {
+    /// The cube of `cube(3, 0.05)` with its central mid node pushed out far enough to
+    /// leave invalid elements.
+    fn tangled_cube() -> (crate::optimize::testmesh::CubeMesh, TetMesh) {
         let c = cube(3, 0.05);
-        let bnd = c.boundary();
         let mut m = c.p2();
         let n = central_mid(&m, c.n_surf) as usize;
         m.nodes[n][0] += 0.25;
         m.nodes[n][1] -= 0.15;
-        let bad = uncertified(&m);
-        assert!(!bad.is_empty(), "the test needs invalid elements");
+        assert!(
+            !uncertified(&m).is_empty(),
+            "the test needs invalid elements"
+        );
+        (c, m)
+    }
+
+    #[test]
+    fn untangles_an_invalid_patch_and_keeps_the_boundary() {
+        let (c, mut m) = tangled_cube();
+        let bnd = c.boundary();
         let surf_before = m.nodes[..c.n_surf].to_vec();
         let st = optimize_high_order(&mut m, &bnd, &HighOrderParams::default());
         assert!(uncertified(&m).is_empty(), "{st:?}");
@@ -725,16 +734,8 @@ mod tests {
 
     #[test]
     fn rounds_go_on_while_an_element_is_invalid() {
-        let c = cube(3, 0.05);
+        let (c, m) = tangled_cube();
         let bnd = c.boundary();
-        let mut m = c.p2();
-        let n = central_mid(&m, c.n_surf) as usize;
-        m.nodes[n][0] += 0.25;
-        m.nodes[n][1] -= 0.15;
-        assert!(
-            !uncertified(&m).is_empty(),
-            "the test needs invalid elements"
-        );
         // The tangle starts poor (below reach_below): the staged rounds apply. With none
         // planned, only invalid elements keep rounds going, and they stop once all are
         // valid.
