@@ -188,7 +188,7 @@ typedef struct curvetet_options {
     int32_t uniform_size;
     /**
      * Nonzero: more high-order rounds where some element starts poor (CAD parts), for
-     * fewer elements left between the worst one and min J / max J 0.85, at about three
+     * fewer elements left between the worst one and min J / max J 0.85, at two to three
      * times that stage's work there. Default 0. (Added after `uniform_size`, in what
      * was its padding: `struct_size` did not grow, so older callers get the default
      * through `curvetet_options_default` or `curvetet_options_init`, as every caller

@@ -49,7 +49,7 @@ pub struct Options {
     pub optimize: bool,
     /// Where some element starts poor (the screw, the hinge), run the high-order stage's
     /// thorough rounds ([`HighOrderParams::thorough`](crate::optimize::HighOrderParams::thorough)):
-    /// about three times its work there, for fewer elements left between the worst and
+    /// two to three times its work there, for fewer elements left between the worst and
     /// the threshold (screw: 78 instead of 204 of 734 below min J / max J 0.85); the
     /// worst element is about as good either way.
     pub thorough: bool,

@@ -324,7 +324,7 @@ def generate(alpha=1.5, optimize=True, size=0.0, threads=0, progress=None, thoro
     high-order optimization; size: target edge length (<= 0: graded from the boundary);
     threads: worker threads (0: all cores); progress: optional callable(fraction, stage)
     returning True to cancel; thorough: more high-order rounds where some element starts
-    poor (CAD parts), about three times that stage's work there, for fewer elements left
+    poor (CAD parts), two to three times that stage's work there, for fewer elements left
     between the worst one and min J / max J 0.85.
 
     Raises CurvetetError with curvetet's message when a volume cannot be meshed; every

@@ -158,7 +158,7 @@ void FilterCurveTetPlugin::initParameterSet(QAction *action, MeshModel &m, RichP
 		                      "positions of the free quadratic nodes."));
 		par.addParam(RichBool("thorough", false, "Thorough",
 		                      "More high-order rounds where some element starts poor (CAD "
-		                      "parts): about three times that stage's work there, for fewer "
+		                      "parts): two to three times that stage's work there, for fewer "
 		                      "elements left between the worst one and a scaled Jacobian of 0.85."));
 		par.addParam(RichSaveFile("outputFile", out, ".msh", "Output file (.msh or .vtu)",
 		                          "Where the quadratic tetrahedral mesh is written: .msh (Gmsh 4.1) "

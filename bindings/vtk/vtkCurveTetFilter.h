@@ -85,7 +85,7 @@ public:
   ///@{
   /**
    * More high-order rounds where some element starts poor (CAD parts such as the screw):
-   * about three times that stage's work there, for fewer elements left between the worst
+   * two to three times that stage's work there, for fewer elements left between the worst
    * one and min J / max J 0.85; the worst is about as good either way. Default off.
    */
   vtkSetMacro(Thorough, vtkTypeBool);

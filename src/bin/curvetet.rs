@@ -182,7 +182,7 @@ struct MeshOptions {
     #[arg(long)]
     no_optimize: bool,
     /// More high-order rounds where some element starts poor (CAD parts such as the
-    /// screw): about three times that stage's work, for fewer elements left between the
+    /// screw): two to three times that stage's work, for fewer elements left between the
     /// worst one and min J / max J 0.85; the worst is about as good either way
     #[arg(long, conflicts_with = "no_optimize")]
     thorough: bool,

@@ -34,25 +34,26 @@ use patch::{colour, Marks, NodeElems, Patch};
 use rayon::prelude::*;
 
 /// Tuning of the high-order stage.
+///
+/// Where some element starts below [`reach_below`](Self::reach_below) (the screw, the
+/// hinge), the rounds are staged: [`reach`](Self::reach), [`layers`](Self::layers),
+/// [`rounds`](Self::rounds), [`iterations`](Self::iterations),
+/// [`barrier_updates`](Self::barrier_updates) and [`stop_slack`](Self::stop_slack) apply;
+/// elsewhere the `direct_` fields do. The staged defaults spend the effort on the worst
+/// elements: two rounds of two-layer patches with 8 L-BFGS iterations per barrier.
+/// Against [`HighOrderParams::thorough`] (five rounds of one-layer patches, 6
+/// iterations, reach 0.2: the defaults until 2026-11-24), measured on the screw: 15k
+/// element evaluations instead of 50k, certified min J / max J 0.630 instead of 0.626,
+/// but 204 elements left below the threshold instead of 78 (mean 0.891 instead of
+/// 0.924); on the hinge the same minimum (0.436), 125k evaluations instead of 282k, max
+/// skewness 0.831 instead of 0.812. `examples/optimize_tradeoff` measures both.
 #[derive(Clone, Debug)]
 pub struct HighOrderParams {
     /// Elements with certified min J / max J below this seed patches.
     pub threshold: f64,
     /// Each round aims at most this far above the current worst element (the round's
     /// threshold is min(threshold, max(worst, 0) + reach)): effort goes to the worst
-    /// first, and to every invalid element while some are left.
-    ///
-    /// This field, [`layers`](Self::layers), [`rounds`](Self::rounds),
-    /// [`iterations`](Self::iterations) and [`stop_slack`](Self::stop_slack) tune the
-    /// staged rounds (where some element starts below [`reach_below`](Self::reach_below):
-    /// the screw, the hinge). Their defaults spend the effort on the worst elements: two
-    /// rounds of two-layer patches with 8 L-BFGS iterations per barrier. Against
-    /// [`HighOrderParams::thorough`] (five rounds of one-layer patches, 6 iterations,
-    /// reach 0.2, the defaults until 2026-11-24), measured on the screw: 15k element
-    /// evaluations instead of 50k, certified min J / max J 0.630 instead of 0.626, but
-    /// 204 elements left below the threshold instead of 78 (mean 0.891 instead of
-    /// 0.924); on the hinge the same minimum (0.436), half the time, max skewness 0.831
-    /// instead of 0.812. `examples/optimize_tradeoff` measures both.
+    /// first, and to every invalid element while some are left. Staged rounds only.
     pub reach: f64,
     /// When the worst element is at least this good at the start, every round aims at
     /// the threshold directly (staging only pays where some element is poor).
@@ -115,8 +116,8 @@ pub struct HighOrderParams {
 
 impl HighOrderParams {
     /// More staged rounds: five rounds of one-layer patches, 6 iterations per barrier,
-    /// reach 0.2 (see [`HighOrderParams::reach`]). About three times the staged rounds'
-    /// work for a better distribution above the worst element; surfaces whose worst
+    /// reach 0.2 (see [`HighOrderParams`]). Two to three times the staged rounds' work
+    /// for a better distribution above the worst element; surfaces whose worst
     /// element starts at [`reach_below`](Self::reach_below) or better are unaffected
     /// (they use the `direct_` fields).
     pub fn thorough() -> Self {
