@@ -95,6 +95,28 @@ floor!(lv, 0.84, 0.62, 63_000);
 floor!(screw, 0.62, 0.68, 18_000);
 floor!(hinge, 0.43, 0.85, 150_000);
 
+/// Where the staged high-order rounds each lift the worst element to their aim (the reach
+/// held them back, not the optimizer), they go on past `HighOrderParams::rounds`: a P2
+/// torus of 16 x 30 segments (elongated triangles) starts at 0.27 and ends at the
+/// threshold. (Two rounds alone end at 0.57.)
+#[test]
+fn staged_rounds_go_on_while_they_reach_their_aim() {
+    let (nodes, tris) = curvetet::surface::demo::torus(16, 30, 1.0, 0.35);
+    let n = tris.len();
+    let s = Surface::new(nodes, tris, vec![0; n]).expect("torus");
+    let g = generate(&s, &Options::default()).expect("16 x 30 torus");
+    let ho = &g.optimize.high_order;
+    let prm = curvetet::optimize::HighOrderParams::default();
+    assert!(ho.min_scaled_jacobian[0] < prm.reach_below, "{ho:?}");
+    assert_eq!(ho.invalid, [0, 0], "{ho:?}");
+    assert!(
+        ho.rounds > prm.rounds && ho.rounds <= prm.max_rounds,
+        "{ho:?}"
+    );
+    assert!(ho.min_scaled_jacobian[1] > 0.84, "{ho:?}");
+    assert_eq!(g.report.num_invalid, 0);
+}
+
 /// `Options::thorough` spends more high-order work where some element starts poor, for
 /// fewer elements left below the threshold; the worst stays above the floor either way.
 #[test]
