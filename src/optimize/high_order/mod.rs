@@ -229,49 +229,43 @@ pub fn optimize_high_order(
     // Set once a round improved nothing with vertices held back: from then on vertices
     // may move in every patch below the threshold.
     let mut escalate = false;
-    let (rounds, max_rounds) = if direct {
-        (prm.direct_rounds, prm.direct_rounds)
+    // This mesh's tuning, staged or direct, resolved once.
+    let tuned = if direct {
+        HighOrderParams {
+            layers: prm.direct_layers,
+            rounds: prm.direct_rounds,
+            max_rounds: prm.direct_rounds,
+            iterations: prm.direct_iterations,
+            stop_slack: prm.direct_stop_slack,
+            barrier_updates: prm.direct_barrier_updates,
+            ..prm.clone()
+        }
     } else {
-        (prm.rounds, prm.max_rounds.max(prm.rounds))
+        HighOrderParams {
+            max_rounds: prm.max_rounds.max(prm.rounds),
+            ..prm.clone()
+        }
     };
-    let mut reached_aim = false;
-    for round in 0..max_rounds {
-        let worst = sj.iter().copied().fold(f64::INFINITY, f64::min);
-        if round >= rounds && !reached_aim && !sj.iter().any(|&v| v.is_nan() || v <= 0.0) {
+    // The last round's aim; reaching it means the reach, not the optimizer, held the
+    // worst element back, so another round can lift it further.
+    let mut aim = f64::INFINITY;
+    for round in 0..tuned.max_rounds {
+        let (worst, invalid, _) = census(&sj);
+        if round >= tuned.rounds && worst < aim && invalid == 0 {
             break;
         }
         let rp = HighOrderParams {
-            layers: if direct {
-                prm.direct_layers
-            } else {
-                prm.layers
-            },
-            iterations: if direct {
-                prm.direct_iterations
-            } else {
-                prm.iterations
-            },
             vertices_below: if escalate {
                 prm.threshold
             } else {
                 prm.vertices_below
-            },
-            stop_slack: if direct {
-                prm.direct_stop_slack
-            } else {
-                prm.stop_slack
-            },
-            barrier_updates: if direct {
-                prm.direct_barrier_updates
-            } else {
-                prm.barrier_updates
             },
             threshold: if direct {
                 prm.threshold
             } else {
                 prm.threshold.min(worst.max(0.0) + prm.reach)
             },
-            ..prm.clone()
+            ..tuned.clone()
         };
         let prm = &rp;
         let mut seeds: Vec<u32> = (0..ne as u32)
@@ -320,10 +314,7 @@ pub fn optimize_high_order(
         st.patch_elements += patches.iter().map(|p| p.elems.len() as u64).sum::<u64>();
         st.element_evaluations += done.work;
         st.patches_improved += done.improved;
-        // The round lifted the worst element to its aim: the reach, not the optimizer,
-        // held it back, so another round can lift it further.
-        let lifted = sj.iter().copied().fold(f64::INFINITY, f64::min);
-        reached_aim = lifted >= prm.threshold;
+        aim = prm.threshold;
         if done.improved == 0 {
             if escalate || prm.vertices_below >= prm.threshold || !prm.move_vertices {
                 break;

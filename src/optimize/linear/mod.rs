@@ -219,7 +219,7 @@ fn run_passes(
     failed: &mut Vec<u64>,
 ) {
     let full_goal = 1.0 - prm.goal_skewness;
-    let start_bad = census(m, full_goal).1;
+    let (mut worst, start_bad) = census(m, full_goal);
     let mut out_of_reach = false;
     for _ in 0..prm.max_passes {
         if !attempt_left(prm, st) {
@@ -228,7 +228,7 @@ fn run_passes(
         st.passes += 1;
         let goal = if out_of_reach {
             st.reach_passes += 1;
-            full_goal.min(census(m, full_goal).0 + prm.reach)
+            full_goal.min(worst + prm.reach)
         } else {
             full_goal
         };
@@ -259,7 +259,9 @@ fn run_passes(
                 failed[ti] = m.clock;
             }
         }
-        out_of_reach = out_of_reach || census(m, full_goal).1 > start_bad;
+        let (w, bad) = census(m, full_goal);
+        worst = w;
+        out_of_reach = out_of_reach || bad > start_bad;
         if changed == 0 {
             break;
         }
