@@ -283,13 +283,33 @@ class TestOptions(GmshCase):
         opt = curvetet_gmsh._Options.from_buffer_copy(buf.raw[:size])
         self.assertEqual((opt.optimize, opt.uniform_size, opt.thorough), (1, 0, 0))
 
-    def test_thorough_meshes(self):
-        gmsh.model.occ.addSphere(0, 0, 0, 1)
-        gmsh.model.occ.synchronize()
-        self.surface_mesh_order2(0.3)
-        tris = surface_triangles()
-        curvetet_gmsh.generate(thorough=True)
-        self.check_volume_mesh(tris)
+    def test_thorough_reaches_curvetet(self):
+        # The flag curvetet_generate receives (a sphere starts fair, so the meshes
+        # themselves would not tell).
+        def sphere():
+            gmsh.clear()
+            gmsh.model.occ.addSphere(0, 0, 0, 1)
+            gmsh.model.occ.synchronize()
+            self.surface_mesh_order2(0.3)
+            return surface_triangles()
+
+        lib = curvetet_gmsh._load()
+        real = lib.curvetet_generate
+        seen = []
+
+        def spy(surface, opt, mesh):
+            seen.append(opt._obj.thorough)
+            return real(surface, opt, mesh)
+
+        lib.curvetet_generate = spy
+        try:
+            for flag in (True, False):
+                tris = sphere()
+                curvetet_gmsh.generate(thorough=flag)
+                self.check_volume_mesh(tris)
+        finally:
+            lib.curvetet_generate = real
+        self.assertEqual(seen, [1, 0])
 
 
 if __name__ == "__main__":
