@@ -156,6 +156,13 @@ pub(crate) struct Mesher<'a> {
     stats: FrontStats,
     repairs_at: HashMap<(i32, i32, i32), u32>,
     repair_cell: f64,
+    /// Live front faces.
+    open_faces: usize,
+    /// The fewest live front faces so far, and the repair count when the front had them
+    /// (see [`MAX_REPAIRS_WITHOUT_PROGRESS`]).
+    fewest_open: (usize, u64),
+    /// [`MAX_REPAIRS_WITHOUT_PROGRESS`] (a field so that the tests can lower it).
+    max_repairs_without_progress: u64,
     // scratch
     near_ids: Vec<u32>,
     near: Vec<FaceRef>,
@@ -217,6 +224,9 @@ impl<'a> Mesher<'a> {
             alpha: opts.alpha,
             stats: FrontStats::default(),
             repairs_at: HashMap::default(),
+            open_faces: 0,
+            fewest_open: (usize::MAX, 0),
+            max_repairs_without_progress: MAX_REPAIRS_WITHOUT_PROGRESS,
             repair_cell: 2.0 * mean_edge,
             near_ids: Vec::new(),
             near: Vec::new(),
@@ -242,6 +252,7 @@ impl<'a> Mesher<'a> {
             u32::MAX
         };
         self.face_alive.push(true);
+        self.open_faces += 1;
         self.faces.push(Face {
             v,
             alive: true,
@@ -359,6 +370,7 @@ impl<'a> Mesher<'a> {
             return;
         }
         f.alive = false;
+        self.open_faces -= 1;
         let v = f.v;
         self.face_alive[id as usize] = false;
         for k in 0..3 {
@@ -427,6 +439,9 @@ impl<'a> Mesher<'a> {
                 continue;
             }
             self.stats.steps += 1;
+            if self.open_faces < self.fewest_open.0 {
+                self.fewest_open = (self.open_faces, self.stats.repairs);
+            }
             if self.stats.steps > max_steps {
                 return Err(self.stuck_error(fid, "step limit reached"));
             }
@@ -476,6 +491,15 @@ impl<'a> Mesher<'a> {
             // ...else remesh around it.
             if self.stats.repairs >= max_repairs {
                 return Err(self.stuck_error(fid, "repair limit reached"));
+            }
+            let stalled = self.stats.repairs - self.fewest_open.1;
+            if stalled >= self.max_repairs_without_progress {
+                let why = format!(
+                    "{stalled} local remeshings without closing more of the front (it had {} \
+                     faces at its fewest)",
+                    self.fewest_open.0
+                );
+                return Err(self.stuck_error(fid, &why));
             }
             self.repair(fid)?;
         }
@@ -897,6 +921,16 @@ fn curved_valid(x: &[P3; 10]) -> bool {
     certify(x).is_valid()
 }
 
+/// A front attempt gives up (and the next [`RESTARTS`] configuration runs) after this many
+/// local remeshings since the front last had fewer live faces than ever before: it is
+/// cycling, deleting and refilling the same pockets. Measured with `scripts/aniso-torus.py`
+/// surfaces: attempts that closed went at most 66 repairs without a new fewest (30 x 50's
+/// second attempt; 8 on the hinge, 0-15 elsewhere), while the attempts that failed went on
+/// 71-278 repairs past theirs, at 1.5-2 ms a step, before the per-region limit stopped
+/// them: 30 x 60 took 78 s for its three failed attempts and the fourth that closed, and
+/// now takes 15 s for the same mesh.
+pub const MAX_REPAIRS_WITHOUT_PROGRESS: u64 = 80;
+
 /// Restart schedule, as (alpha factor, size factor): when local remeshing cannot close the
 /// front, the whole front runs again with a narrower, then a wider candidate search, then a
 /// finer size. The front is greedy; another radius changes every choice it makes, so a
@@ -958,4 +992,38 @@ pub fn run_front(
         ),
         partial: last_partial,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn screw() -> crate::Surface {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/screw_p2.msh");
+        crate::io::read_any_surface(&path, &Default::default()).expect("screw")
+    }
+
+    #[test]
+    fn an_attempt_that_stops_closing_the_front_gives_up() {
+        let s = screw();
+        let opts = Options::default();
+        let size = crate::generate::size_field(&s, &opts);
+        // The screw's first attempt closes after two repairs; the open-face count it
+        // keeps agrees with the faces.
+        let mut m = Mesher::new(s.nodes(), s.triangles(), &opts, &size);
+        m.run(&mut |_, _| false).expect("the screw closes");
+        assert!(m.stats.repairs > 0, "{:?}", m.stats);
+        assert_eq!(m.open_faces, m.faces.iter().filter(|f| f.alive).count());
+        assert_eq!(m.open_faces, 0);
+        assert!(m.fewest_open.0 > 0 && m.fewest_open.1 <= m.stats.repairs);
+        // With no repair allowed past the fewest open faces, the first repair ends it.
+        let mut m = Mesher::new(s.nodes(), s.triangles(), &opts, &size);
+        m.max_repairs_without_progress = 0;
+        let err = m.run(&mut |_, _| false).expect_err("gives up").to_string();
+        assert!(
+            err.contains("local remeshings without closing more of the front"),
+            "{err}"
+        );
+        assert_eq!(m.stats.repairs, 0, "{:?}", m.stats);
+    }
 }

@@ -229,9 +229,10 @@ pub fn aspect_ratio(a: P3, b: P3, c: P3) -> f64 {
 /// this are made of elongated triangles, on which the advancing front may not close:
 /// long boundary edges next to short ones. Tori from `scripts/aniso-torus.py`: 12-25 ×
 /// 27-54 with median 3.5-4.0 left the front stuck (one, 12 × 27 `--no-shift` at 4.3,
-/// meshed); 30 × 60 (3.4) closed only on the fourth front attempt, after 75-81 s, and
-/// 30 × 50 on the second, after 21 s; 25-50 × 30-60 otherwise, median 1.8-3.1, meshed on
-/// the first. The six benchmark surfaces have 1.03-1.21.
+/// meshed); 30 × 60 (3.4) closed only on the fourth front attempt, after 15 s (75-81 s
+/// before [`crate::front::MAX_REPAIRS_WITHOUT_PROGRESS`] cut the failed attempts short),
+/// and 30 × 50 on the second, after 21 s; 25-50 × 30-60 otherwise, median 1.8-3.1, meshed
+/// on the first. The six benchmark surfaces have 1.03-1.21.
 pub const ELONGATED_MEDIAN_ASPECT_RATIO: f64 = 3.3;
 
 /// The corner triangles' aspect ratios ([`aspect_ratio`]) summed up for the front.
