@@ -183,10 +183,11 @@ int vtkCurveTetFilter::FillInputPortInformation(int, vtkInformation* info)
 int vtkCurveTetFilter::ProgressCallback(void* user, double fraction, const char* stage)
 {
   auto* self = static_cast<vtkCurveTetFilter*>(user);
-  // curvetet's stages: "front" (most of the time), then "certify"; the optimization and
-  // the copy into VTK take the rest.
+  // curvetet's stages: "front" (most of the time; "front (attempt 2 of 4)" and so on
+  // when it starts again, from 0), then "certify"; the optimization and the copy into VTK
+  // take the rest. Progress shown never goes back.
   double p = self->LastProgress;
-  if (stage && std::strcmp(stage, "front") == 0)
+  if (stage && std::strncmp(stage, "front", 5) == 0)
   {
     p = 0.05 + 0.8 * fraction;
   }

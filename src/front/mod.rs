@@ -163,6 +163,8 @@ pub(crate) struct Mesher<'a> {
     fewest_open: (usize, u64),
     /// [`MAX_REPAIRS_WITHOUT_PROGRESS`] (a field so that the tests can lower it).
     max_repairs_without_progress: u64,
+    /// The stage name progress is reported under ([`attempt_stage`]).
+    stage: String,
     // scratch
     near_ids: Vec<u32>,
     near: Vec<FaceRef>,
@@ -227,6 +229,7 @@ impl<'a> Mesher<'a> {
             open_faces: 0,
             fewest_open: (usize::MAX, 0),
             max_repairs_without_progress: MAX_REPAIRS_WITHOUT_PROGRESS,
+            stage: attempt_stage(0),
             repair_cell: 2.0 * mean_edge,
             near_ids: Vec::new(),
             near: Vec::new(),
@@ -445,10 +448,14 @@ impl<'a> Mesher<'a> {
             if self.stats.steps > max_steps {
                 return Err(self.stuck_error(fid, "step limit reached"));
             }
-            let frac = (self.volume_done / total_volume).clamp(0.0, 1.0);
+            // The filled fraction of the volume, never reported lower than before (local
+            // remeshing deletes tets; the progress contract is non-decreasing).
+            let frac = (self.volume_done / total_volume)
+                .clamp(0.0, 1.0)
+                .max(last_report);
             if frac - last_report >= 0.01 || self.stats.steps % 4096 == 0 {
                 last_report = frac;
-                if progress(frac, "front") {
+                if progress(frac, &self.stage) {
                     return Err(Error::Cancelled);
                 }
             }
@@ -939,6 +946,17 @@ pub const MAX_REPAIRS_WITHOUT_PROGRESS: u64 = 80;
 /// the attempt that succeeded.
 pub const RESTARTS: [(f64, f64); 4] = [(1.0, 1.0), (0.8, 1.0), (1.3, 1.0), (1.0, 0.85)];
 
+/// The progress stage name of front attempt `attempt` (0-based, [`RESTARTS`]): "front",
+/// then "front (attempt 2 of 4)" and so on, so that a restart, whose fraction starts again
+/// from 0, is a new stage.
+pub fn attempt_stage(attempt: usize) -> String {
+    if attempt == 0 {
+        "front".to_string()
+    } else {
+        format!("front (attempt {} of {})", attempt + 1, RESTARTS.len())
+    }
+}
+
 /// Run the front on a checked surface's arrays, restarting per [`RESTARTS`] when it
 /// cannot close, starting with attempt `first` (a caller whose later stages refuse a
 /// front's result asks for the next configuration; `stats.restarts` says which one
@@ -960,6 +978,7 @@ pub fn run_front(
         m.stats.restarts = attempt as u32;
         m.stats.alpha = m.alpha;
         m.stats.size_scale = fs;
+        m.stage = attempt_stage(attempt);
         match m.run(progress) {
             Ok(()) => {
                 // The live tets and their qualities.
@@ -977,7 +996,7 @@ pub fn run_front(
             Err(Error::MeshingFailed { msg, partial }) => {
                 failures.push(format!("alpha {:.3}, size x{fs}: {msg}", m.alpha));
                 last_partial = partial;
-                if attempt + 1 < RESTARTS.len() && progress(0.0, "front (restart)") {
+                if attempt + 1 < RESTARTS.len() && progress(0.0, &attempt_stage(attempt + 1)) {
                     return Err(Error::Cancelled);
                 }
             }
@@ -1025,5 +1044,46 @@ mod tests {
             "{err}"
         );
         assert_eq!(m.stats.repairs, 0, "{:?}", m.stats);
+    }
+
+    /// (fraction, stage) of every progress call of `run_front` from attempt `first`.
+    fn progress_of(s: &crate::Surface, first: usize) -> (Vec<(f64, String)>, FrontStats) {
+        let opts = Options::default();
+        let size = crate::generate::size_field(s, &opts);
+        let mut calls = Vec::new();
+        let out = run_front(
+            s.nodes(),
+            s.triangles(),
+            &opts,
+            &size,
+            first,
+            &mut |f, st| {
+                calls.push((f, st.to_string()));
+                false
+            },
+        )
+        .expect("closes");
+        (calls, out.stats)
+    }
+
+    #[test]
+    fn progress_never_goes_back_within_a_stage_and_names_the_attempt() {
+        // The hinge's front remeshes locally (deleting tets, so the filled volume drops).
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hinge_p2.msh");
+        let hinge = crate::io::read_any_surface(&path, &Default::default()).expect("hinge");
+        let (calls, stats) = progress_of(&hinge, 0);
+        assert!(stats.repairs > 10, "{stats:?}");
+        assert!(calls.len() > 50 && calls.iter().all(|c| c.1 == "front"));
+        for w in calls.windows(2) {
+            assert!(w[1].0 >= w[0].0, "{} then {}", w[0].0, w[1].0);
+        }
+        // A later attempt is a stage of its own (its fraction starts from 0 again).
+        let (calls, stats) = progress_of(&screw(), 1);
+        assert_eq!(stats.restarts, 1);
+        assert!(!calls.is_empty());
+        assert!(
+            calls.iter().all(|c| c.1 == "front (attempt 2 of 4)"),
+            "{calls:?}"
+        );
     }
 }
