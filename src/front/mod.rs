@@ -936,6 +936,7 @@ fn curved_valid(x: &[P3; 10]) -> bool {
 /// 71-278 repairs past theirs (0.4-1.1 million steps at about 30 µs each, against 7 µs on
 /// the 100k-tet torus) before the per-region limit stopped them: 30 x 60 took 78 s for its
 /// three failed attempts and the fourth that closed, and now takes 15 s for the same mesh.
+/// The last attempt is exempt ([`repairs_without_progress_limit`]).
 pub const MAX_REPAIRS_WITHOUT_PROGRESS: u64 = 80;
 
 /// Restart schedule, as (alpha factor, size factor): when local remeshing cannot close the
@@ -945,6 +946,18 @@ pub const MAX_REPAIRS_WITHOUT_PROGRESS: u64 = 80;
 /// at 2.0). Deterministic: the same input always takes the same attempts; the report gives
 /// the attempt that succeeded.
 pub const RESTARTS: [(f64, f64); 4] = [(1.0, 1.0), (0.8, 1.0), (1.3, 1.0), (1.0, 0.85)];
+
+/// [`MAX_REPAIRS_WITHOUT_PROGRESS`] for attempt `attempt` ([`RESTARTS`]), except the last:
+/// with nothing left to restart with, it keeps going until the per-region or overall
+/// limits (a cycling attempt occasionally closes: 30 x 50's second went 66 repairs without
+/// progress, then closed).
+fn repairs_without_progress_limit(attempt: usize) -> u64 {
+    if attempt + 1 < RESTARTS.len() {
+        MAX_REPAIRS_WITHOUT_PROGRESS
+    } else {
+        u64::MAX
+    }
+}
 
 /// The progress stage name of front attempt `attempt` (0-based, [`RESTARTS`]): "front",
 /// then "front (attempt 2 of 4)" and so on, so that a restart, whose fraction starts again
@@ -979,6 +992,7 @@ pub fn run_front(
         m.stats.alpha = m.alpha;
         m.stats.size_scale = fs;
         m.stage = attempt_stage(attempt);
+        m.max_repairs_without_progress = repairs_without_progress_limit(attempt);
         match m.run(progress) {
             Ok(()) => {
                 // The live tets and their qualities.
@@ -1044,6 +1058,15 @@ mod tests {
             "{err}"
         );
         assert_eq!(m.stats.repairs, 0, "{:?}", m.stats);
+    }
+
+    #[test]
+    fn only_the_last_attempt_keeps_cycling() {
+        let n = RESTARTS.len();
+        assert!(
+            (0..n - 1).all(|a| repairs_without_progress_limit(a) == MAX_REPAIRS_WITHOUT_PROGRESS)
+        );
+        assert_eq!(repairs_without_progress_limit(n - 1), u64::MAX);
     }
 
     /// (fraction, stage) of every progress call of `run_front` from attempt `first`.
