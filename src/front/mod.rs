@@ -161,7 +161,7 @@ pub(crate) struct Mesher<'a> {
     /// The fewest live front faces so far, and the repair count when the front had them
     /// (see [`MAX_REPAIRS_WITHOUT_PROGRESS`]).
     fewest_open: (usize, u64),
-    /// [`MAX_REPAIRS_WITHOUT_PROGRESS`] (a field so that the tests can lower it).
+    /// This attempt's [`repairs_without_progress_limit`] (the tests lower it).
     max_repairs_without_progress: u64,
     /// The stage name progress is reported under ([`attempt_stage`]).
     stage: String,
@@ -228,7 +228,7 @@ impl<'a> Mesher<'a> {
             repairs_at: HashMap::default(),
             open_faces: 0,
             fewest_open: (usize::MAX, 0),
-            max_repairs_without_progress: MAX_REPAIRS_WITHOUT_PROGRESS,
+            max_repairs_without_progress: repairs_without_progress_limit(0),
             stage: attempt_stage(0),
             repair_cell: 2.0 * mean_edge,
             near_ids: Vec::new(),
@@ -936,7 +936,7 @@ fn curved_valid(x: &[P3; 10]) -> bool {
 /// 71-278 repairs past theirs (0.4-1.1 million steps at about 30 µs each, against 7 µs on
 /// the 100k-tet torus) before the per-region limit stopped them: 30 x 60 took 78 s for its
 /// three failed attempts and the fourth that closed, and now takes 15 s for the same mesh.
-/// The last attempt is exempt ([`repairs_without_progress_limit`]).
+/// The last of the [`RESTARTS`] is exempt: with nothing left to restart with, it goes on.
 pub const MAX_REPAIRS_WITHOUT_PROGRESS: u64 = 80;
 
 /// Restart schedule, as (alpha factor, size factor): when local remeshing cannot close the
@@ -962,7 +962,7 @@ fn repairs_without_progress_limit(attempt: usize) -> u64 {
 /// The progress stage name of front attempt `attempt` (0-based, [`RESTARTS`]): "front",
 /// then "front (attempt 2 of 4)" and so on, so that a restart, whose fraction starts again
 /// from 0, is a new stage.
-pub fn attempt_stage(attempt: usize) -> String {
+fn attempt_stage(attempt: usize) -> String {
     if attempt == 0 {
         "front".to_string()
     } else {
@@ -1031,14 +1031,16 @@ pub fn run_front(
 mod tests {
     use super::*;
 
-    fn screw() -> crate::Surface {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/screw_p2.msh");
-        crate::io::read_any_surface(&path, &Default::default()).expect("screw")
+    /// `tests/data/NAME_p2.msh`.
+    fn data_surface(name: &str) -> crate::Surface {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("tests/data/{name}_p2.msh"));
+        crate::io::read_any_surface(&path, &Default::default()).expect(name)
     }
 
     #[test]
     fn an_attempt_that_stops_closing_the_front_gives_up() {
-        let s = screw();
+        let s = data_surface("screw");
         let opts = Options::default();
         let size = crate::generate::size_field(&s, &opts);
         // The screw's first attempt closes after two repairs; the open-face count it
@@ -1092,16 +1094,14 @@ mod tests {
     #[test]
     fn progress_never_goes_back_within_a_stage_and_names_the_attempt() {
         // The hinge's front remeshes locally (deleting tets, so the filled volume drops).
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/hinge_p2.msh");
-        let hinge = crate::io::read_any_surface(&path, &Default::default()).expect("hinge");
-        let (calls, stats) = progress_of(&hinge, 0);
+        let (calls, stats) = progress_of(&data_surface("hinge"), 0);
         assert!(stats.repairs > 10, "{stats:?}");
         assert!(calls.len() > 50 && calls.iter().all(|c| c.1 == "front"));
         for w in calls.windows(2) {
             assert!(w[1].0 >= w[0].0, "{} then {}", w[0].0, w[1].0);
         }
         // A later attempt is a stage of its own (its fraction starts from 0 again).
-        let (calls, stats) = progress_of(&screw(), 1);
+        let (calls, stats) = progress_of(&data_surface("screw"), 1);
         assert_eq!(stats.restarts, 1);
         assert!(!calls.is_empty());
         assert!(

@@ -51,8 +51,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace
