@@ -98,6 +98,18 @@ pub fn dihedral_extremes(c: &[P3; 4]) -> (f64, f64) {
     )
 }
 
+/// The interior dihedral angle (degrees) at edge (u, v) of the tet (u, v, a, b): the
+/// angle between the half-planes bounded by the line uv through `a` and through `b`, in
+/// [0, 180], whatever the tet's orientation. One atan2, for callers that need one edge.
+#[inline]
+pub fn dihedral_at_edge(u: P3, v: P3, a: P3, b: P3) -> f64 {
+    let e = sub(v, u);
+    // e x w turns w's component across e by 90 degrees about e: the angle between the
+    // normals is the angle between the half-planes.
+    let (na, nb) = (cross(e, sub(a, u)), cross(e, sub(b, u)));
+    norm(cross(na, nb)).atan2(dot(na, nb) + 0.0).to_degrees()
+}
+
 /// Equiangular skewness from the smallest and largest dihedral angles (degrees): paper
 /// eq. 2, max[(θmax − θe)/(180 − θe), (θe − θmin)/θe].
 #[inline]
@@ -447,6 +459,30 @@ mod tests {
     #[test]
     fn theta_e_is_acos_one_third() {
         assert!(((1.0f64 / 3.0).acos().to_degrees() - EQUIANGULAR_DIHEDRAL_DEG).abs() < 1e-13);
+    }
+
+    #[test]
+    fn dihedral_at_edge_matches_dihedral_angles() {
+        use rand::Rng;
+        let mut rng = StdRng::seed_from_u64(5);
+        for n in 0..400 {
+            // Well-shaped tets, then any four points (either orientation, slivers too).
+            let c = if n % 2 == 0 {
+                random_corners(&mut rng)
+            } else {
+                std::array::from_fn(|_| std::array::from_fn(|_| rng.random_range(-1.0..1.0)))
+            };
+            let a = dihedral_angles(&c);
+            for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
+                let o: Vec<usize> = (0..4).filter(|x| x != i && x != j).collect();
+                for (x, y) in [(o[0], o[1]), (o[1], o[0])] {
+                    let d = dihedral_at_edge(c[*i], c[*j], c[x], c[y]);
+                    assert!((d - a[k]).abs() < 1e-9, "{d} {}", a[k]);
+                    let d = dihedral_at_edge(c[*j], c[*i], c[x], c[y]);
+                    assert!((d - a[k]).abs() < 1e-9, "{d} {}", a[k]);
+                }
+            }
+        }
     }
 
     #[test]

@@ -6,6 +6,9 @@
 
 use super::mesh::{opposite_edge, LinMesh};
 use super::smooth::{smooth_vertex, SmoothParams, SmoothScratch};
+use crate::geom::quality::{dihedral_at_edge, EQUIANGULAR_DIHEDRAL_DEG};
+#[cfg(test)]
+use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::mid;
 
 /// Scratch buffers of the insertion.
@@ -18,6 +21,29 @@ pub(super) struct InsertScratch {
     /// Qualities of the new tets, two per old tet.
     new_q: Vec<f64>,
     added: Vec<u32>,
+}
+
+/// Slack of [`split_bound`] against the minimum a split must beat: far above the
+/// rounding of either (about 1e-15), so a split that could be kept is never skipped.
+const BOUND_MARGIN: f64 = 1e-9;
+
+/// An upper bound on the minimum quality of the tets a split of the edge (a, b) (with
+/// tets `ts`) makes, wherever the new vertex p goes: each old tet (a, b, u, v) becomes
+/// (a, p, u, v) and (p, b, u, v), whose dihedral angles at their shared edge (u, v) add up
+/// to the old tet's there (when both are positive, the plane through u, v and p lies
+/// between a and b); so one of them is at most half of it. A tet's quality is at most
+/// θmin / θe (1 − equiangular skewness, paper eq. 2; a curved part only lowers it).
+/// On the screw 67 of the 101 splits tried are settled by it; 2,193 of 3,821 on the
+/// hinge.
+fn split_bound(m: &LinMesh, a: u32, b: u32, ts: &[u32]) -> f64 {
+    let (pa, pb) = (m.pts[a as usize], m.pts[b as usize]);
+    ts.iter()
+        .map(|&t| {
+            let (u, v) = opposite_edge(m.tets[t as usize], a, b);
+            let theta = dihedral_at_edge(m.pts[u as usize], m.pts[v as usize], pa, pb);
+            theta / (2.0 * EQUIANGULAR_DIHEDRAL_DEG)
+        })
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Try splitting the interior edge (a, b); true when kept.
@@ -45,6 +71,10 @@ pub(super) fn split_edge(
         s.old.push(m.tets[t as usize]);
         s.old_q.push(m.q[t as usize]);
     }
+    // No placement of the new vertex can lift the minimum past `old_min + eps`: the split
+    // still runs and is undone as before (its slots, stars and change clocks steer the
+    // later passes), but the new vertex is not smoothed, which is what a split costs.
+    let doomed = split_bound(m, a, b, &s.ts) + BOUND_MARGIN <= old_min + eps;
     let p = mid(m.pts[a as usize], m.pts[b as usize]);
     // The new tets (a, p, u, v) and (p, b, u, v) for each old (a, b, u, v); all must be
     // positive (exact) before anything changes.
@@ -82,7 +112,9 @@ pub(super) fn split_edge(
             s.added.push(id);
         }
     }
-    smooth_vertex(m, np, prm, ss);
+    if !doomed {
+        smooth_vertex(m, np, prm, ss);
+    }
     let new_min = m.vt[np as usize]
         .iter()
         .map(|&t| m.q[t as usize])
@@ -99,4 +131,73 @@ pub(super) fn split_edge(
         m.add(s.old[i], s.old_q[i]);
     }
     false
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optimize::linear::quality::ElementQuality;
+    use crate::optimize::testmesh::cube;
+    use rand::{Rng, SeedableRng};
+
+    /// Every split of a jittered cube, its new vertex smoothed and the split kept whatever
+    /// it gives (a minimum to beat of old − 10), ends at or below `split_bound`, and the
+    /// bound would have settled some of them (below the old minimum).
+    #[test]
+    fn no_split_beats_its_bound() {
+        let c = cube(3, 0.08);
+        let bnd = c.boundary();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let mut pts = c.pts.clone();
+        for p in pts.iter_mut().skip(c.n_surf) {
+            for x in p.iter_mut() {
+                *x += rng.random_range(-0.1..0.1);
+            }
+        }
+        let mut edges: Vec<(u32, u32)> = c
+            .tets
+            .iter()
+            .flat_map(|t| TET10_EDGES.map(|[i, j]| (t[i].min(t[j]), t[i].max(t[j]))))
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let (mut kept, mut below) = (0, 0);
+        for (a, b) in edges {
+            let mut m = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+            let mut ts = Vec::new();
+            m.edge_tets(a, b, &mut ts);
+            let bound = split_bound(&m, a, b, &ts);
+            let old_min = ts
+                .iter()
+                .map(|&t| m.q[t as usize])
+                .fold(f64::INFINITY, f64::min);
+            let (mut s, mut ss) = (InsertScratch::default(), SmoothScratch::default());
+            if !split_edge(
+                &mut m,
+                a,
+                b,
+                -10.0,
+                &SmoothParams::default(),
+                &mut s,
+                &mut ss,
+            ) {
+                continue;
+            }
+            let np = m.pts.len() - 1;
+            let new_min = m.vt[np]
+                .iter()
+                .map(|&t| m.q[t as usize])
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                new_min <= bound + 1e-12,
+                "({a}, {b}): {new_min} > bound {bound}"
+            );
+            kept += 1;
+            below += usize::from(bound < old_min);
+        }
+        assert!(
+            kept > 100 && below > 20,
+            "{kept} splits, {below} settled by the bound"
+        );
+    }
 }
