@@ -236,7 +236,11 @@ impl LinearJacobian {
         let mut c = [0.0f64; 3];
         for (cd, col) in c.iter_mut().zip(self.cols.iter()) {
             for v in col {
-                *cd = cd.max(dot(*v, *v));
+                // (A plain comparison, not f64::max: cheaper; a NaN is skipped either way.)
+                let n2 = dot(*v, *v);
+                if n2 > *cd {
+                    *cd = n2;
+                }
             }
             *cd = cd.sqrt();
         }

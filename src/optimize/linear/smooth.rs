@@ -7,7 +7,7 @@
 
 use super::mesh::LinMesh;
 use super::quality::skew_pieces;
-use crate::geom::vec3::{dist, dot, norm, P3};
+use crate::geom::vec3::{dist2, dot, norm, P3};
 
 /// Tuning of the smoother.
 #[derive(Clone, Copy, Debug)]
@@ -98,14 +98,17 @@ fn load_star(m: &LinMesh, v: u32, s: &mut SmoothScratch) -> (f64, f64) {
     s.star
         .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
     let p = m.pts[v as usize];
-    let mut min_len = f64::INFINITY;
+    // (sqrt is monotone and correctly rounded: the root of the least square is the least
+    // distance.)
+    let mut min_len2 = f64::INFINITY;
     for &t in &s.star {
         for &x in &m.tets[t as usize] {
             if x != v {
-                min_len = min_len.min(dist(p, m.pts[x as usize]));
+                min_len2 = min_len2.min(dist2(p, m.pts[x as usize]));
             }
         }
     }
+    let min_len = min_len2.sqrt();
     let qmin = s
         .star
         .iter()
@@ -134,14 +137,14 @@ pub(super) fn smooth_vertex(
         // Active pieces and their gradients.
         s.grads.clear();
         for &t in &s.star {
-            let tv = m.tets[t as usize];
-            let k = tv.iter().position(|&x| x == v).unwrap_or(0);
-            let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
             let qt = m.q[t as usize];
             if qt > qmin + prm.active_tol {
                 // Far from active: only its first-order behaviour matters for the step.
                 continue;
             }
+            let tv = m.tets[t as usize];
+            let k = tv.iter().position(|&x| x == v).unwrap_or(0);
+            let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
             if qt < 0.0 {
                 // P2-invalid (curved) tet: finite-difference gradient of its score.
                 let h = 1e-6 * min_len;
