@@ -18,7 +18,7 @@ use curvetet::generate::size_field;
 use curvetet::mesh::build::assemble;
 use curvetet::mesh::quality::{uncertified, QualityReport};
 use curvetet::optimize::{
-    improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams,
+    improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams, RoundTuning,
 };
 use curvetet::{io, Options};
 use std::path::PathBuf;
@@ -66,10 +66,15 @@ fn settings() -> Vec<Setting> {
             for rounds in [5, 4, 3, 2, 1] {
                 for reach in [0.1, 0.15, 0.2] {
                     for iterations in [6, 8] {
+                        // The staged rounds' tuning (the screw's worst element starts
+                        // poor: its rounds are staged).
                         let high = HighOrderParams {
-                            rounds,
                             reach,
-                            iterations,
+                            staged: RoundTuning {
+                                rounds,
+                                iterations,
+                                ..base.staged.clone()
+                            },
                             ..base.clone()
                         };
                         out.push(Setting {

@@ -100,7 +100,7 @@ floor!(screw, SCREW_MIN_SJ, SCREW_MAX_SKEW, 18_000);
 floor!(hinge, 0.43, 0.85, 150_000);
 
 /// Where the staged high-order rounds each lift the worst element to their aim (the reach
-/// held them back, not the optimizer), they go on past `HighOrderParams::rounds`: a P2
+/// held them back, not the optimizer), they go on past the staged `RoundTuning::rounds`: a P2
 /// torus of 16 x 30 segments (elongated triangles) starts at 0.27 and ends at the
 /// threshold. (Two rounds alone end at 0.57.)
 #[test]
@@ -114,7 +114,7 @@ fn staged_rounds_go_on_while_they_reach_their_aim() {
     assert!(ho.min_scaled_jacobian[0] < prm.reach_below, "{ho:?}");
     assert_eq!(ho.invalid, [0, 0], "{ho:?}");
     assert!(
-        ho.rounds > prm.rounds && ho.rounds <= prm.max_rounds,
+        ho.rounds > prm.staged.rounds && ho.rounds <= prm.max_rounds,
         "{ho:?}"
     );
     assert!(ho.min_scaled_jacobian[1] > 0.84, "{ho:?}");

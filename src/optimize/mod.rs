@@ -22,7 +22,7 @@ pub mod linear;
 pub(crate) mod testmesh;
 
 pub use boundary::Boundary;
-pub use high_order::{optimize_high_order, HighOrderParams, HighOrderStats};
+pub use high_order::{optimize_high_order, HighOrderParams, HighOrderStats, RoundTuning};
 pub use linear::{improve_linear, improve_linear_known, LinearParams, LinearStats};
 
 /// What the optimization stages did (part of [`crate::Generated`]).

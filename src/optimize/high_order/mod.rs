@@ -33,13 +33,31 @@ use objective::{nodes, Objective, PatchElem, FIXED};
 use patch::{colour, Marks, NodeElems, Patch};
 use rayon::prelude::*;
 
+/// How the rounds of one kind run: the part of [`HighOrderParams`] that differs between
+/// staged and direct rounds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoundTuning {
+    /// Vertex-neighbour rings around a seed in its patch (round r uses
+    /// `min(layers + r, max_layers)`).
+    pub layers: usize,
+    /// Rounds of (seed, patch, optimize).
+    pub rounds: usize,
+    /// L-BFGS iterations per barrier.
+    pub iterations: usize,
+    /// Barrier updates per patch.
+    pub barrier_updates: usize,
+    /// An L-BFGS run stops once every element of its patch is this far above the
+    /// threshold (so that the neighbours' later patches do not push them straight back
+    /// below it).
+    pub stop_slack: f64,
+}
+
 /// Tuning of the high-order stage.
 ///
 /// Where some element starts below [`reach_below`](Self::reach_below) (the screw, the
-/// hinge), the rounds are staged: [`reach`](Self::reach), [`layers`](Self::layers),
-/// [`rounds`](Self::rounds), [`iterations`](Self::iterations),
-/// [`barrier_updates`](Self::barrier_updates) and [`stop_slack`](Self::stop_slack) apply;
-/// elsewhere the `direct_` fields do. The staged defaults spend the effort on the worst
+/// hinge), the rounds are staged ([`staged`](Self::staged), aiming at most
+/// [`reach`](Self::reach) above the worst element); elsewhere they aim at the threshold
+/// directly ([`direct`](Self::direct)). The staged defaults spend the effort on the worst
 /// elements: two rounds of two-layer patches with 8 L-BFGS iterations per barrier, and
 /// more (up to [`max_rounds`](Self::max_rounds)) while each round lifts the worst element
 /// to its aim.
@@ -53,35 +71,29 @@ use rayon::prelude::*;
 pub struct HighOrderParams {
     /// Elements with certified min J / max J below this seed patches.
     pub threshold: f64,
-    /// Each round aims at most this far above the current worst element (the round's
-    /// threshold is min(threshold, max(worst, 0) + reach)): effort goes to the worst
-    /// first, and to every invalid element while some are left. Staged rounds only.
+    /// Each staged round aims at most this far above the current worst element (the
+    /// round's threshold is min(threshold, max(worst, 0) + reach)): effort goes to the
+    /// worst first, and to every invalid element while some are left.
     pub reach: f64,
-    /// When the worst element is at least this good at the start, every round aims at
-    /// the threshold directly (staging only pays where some element is poor).
+    /// When the worst element is at least this good at the start, the rounds are direct:
+    /// every round aims at the threshold (staging only pays where some element is poor).
     pub reach_below: f64,
-    /// Vertex-neighbour rings around a seed in its patch (round r uses
-    /// `min(layers + r, max_layers)`).
-    pub layers: usize,
-    /// See [`HighOrderParams::layers`].
+    /// The rounds where some element starts below [`reach_below`](Self::reach_below).
+    pub staged: RoundTuning,
+    /// The rounds elsewhere: where every element is already fair, two barrier updates
+    /// suffice (with a stop slack of 0.01, 14-21% less work than three on the sphere,
+    /// torus, tube and lv, the same certified minimum to three decimals).
+    pub direct: RoundTuning,
+    /// Largest patch layers in any round (see [`RoundTuning::layers`]).
     pub max_layers: usize,
-    /// Rounds of (seed, patch, optimize).
-    pub rounds: usize,
-    /// Staged rounds go on past [`HighOrderParams::rounds`], up to this many, while some
+    /// Staged rounds go on past [`RoundTuning::rounds`], up to this many, while some
     /// element is not valid (an untangling needs every round it can get) or the last
     /// round lifted the worst element to its aim (then [`reach`](Self::reach), not the
     /// optimizer, held it back: `scripts/aniso-torus.py 12 27 --no-shift` starting at
     /// 0.17 ended at 0.47 after two rounds, 0.72 after four; the demo torus of 16 x 30 at
     /// 0.57 and 0.85; the screw and the hinge fall short of their second round's aim and
-    /// stop there).
+    /// stop there). Direct rounds make exactly their `rounds`.
     pub max_rounds: usize,
-    /// [`HighOrderParams::layers`] when the worst element is at least
-    /// [`HighOrderParams::reach_below`] at the start (see
-    /// [`HighOrderParams::direct_barrier_updates`]).
-    pub direct_layers: usize,
-    /// [`HighOrderParams::rounds`] when the worst element is at least
-    /// [`HighOrderParams::reach_below`] at the start.
-    pub direct_rounds: usize,
     /// Let interior vertices move too (their edges' mid nodes follow them).
     pub move_vertices: bool,
     /// Vertices move only in a patch whose min J / max J after moving the mid nodes is
@@ -98,27 +110,6 @@ pub struct HighOrderParams {
     pub max_skewness_rescue: f64,
     /// See [`HighOrderParams::max_skewness_rescue`].
     pub rescue_below: f64,
-    /// Barrier updates per patch.
-    pub barrier_updates: usize,
-    /// [`HighOrderParams::barrier_updates`] when the worst element is at least
-    /// [`HighOrderParams::reach_below`] at the start: where every element is already
-    /// fair, two updates suffice (with [`HighOrderParams::direct_stop_slack`], 14-21% less
-    /// work than three on the sphere, torus, tube and lv, the same certified minimum to
-    /// three decimals).
-    pub direct_barrier_updates: usize,
-    /// L-BFGS iterations per barrier.
-    pub iterations: usize,
-    /// [`HighOrderParams::iterations`] when the worst element is at least
-    /// [`HighOrderParams::reach_below`] at the start.
-    pub direct_iterations: usize,
-    /// An L-BFGS run stops once every element of its patch is this far above the
-    /// threshold (so that the neighbours' later patches do not push them straight back
-    /// below it).
-    pub stop_slack: f64,
-    /// [`HighOrderParams::stop_slack`] when the worst element is at least
-    /// [`HighOrderParams::reach_below`] at the start (see
-    /// [`HighOrderParams::direct_barrier_updates`]).
-    pub direct_stop_slack: f64,
 }
 
 impl HighOrderParams {
@@ -126,15 +117,19 @@ impl HighOrderParams {
     /// reach 0.2 (see [`HighOrderParams`]). Two to three times the staged rounds' work
     /// for a better distribution above the worst element; surfaces whose worst
     /// element starts at [`reach_below`](Self::reach_below) or better are unaffected
-    /// (they use the `direct_` fields).
+    /// (their rounds are [`direct`](Self::direct)).
     pub fn thorough() -> Self {
+        let d = HighOrderParams::default();
         HighOrderParams {
             reach: 0.2,
-            layers: 1,
-            rounds: 5,
-            iterations: 6,
-            stop_slack: 0.03,
-            ..HighOrderParams::default()
+            staged: RoundTuning {
+                layers: 1,
+                rounds: 5,
+                iterations: 6,
+                stop_slack: 0.03,
+                ..d.staged.clone()
+            },
+            ..d
         }
     }
 }
@@ -145,25 +140,40 @@ impl Default for HighOrderParams {
             threshold: 0.85,
             reach: 0.15,
             reach_below: 0.35,
-            layers: 2,
+            staged: RoundTuning {
+                layers: 2,
+                rounds: 2,
+                iterations: 8,
+                barrier_updates: 3,
+                stop_slack: 0.05,
+            },
+            direct: RoundTuning {
+                layers: 1,
+                rounds: 5,
+                iterations: 6,
+                barrier_updates: 2,
+                stop_slack: 0.01,
+            },
             max_layers: 2,
-            rounds: 2,
             max_rounds: 5,
-            direct_layers: 1,
-            direct_rounds: 5,
             move_vertices: true,
             vertices_below: 0.7,
             max_skewness: 0.7,
             max_skewness_rescue: 0.8,
             rescue_below: 0.5,
-            barrier_updates: 3,
-            iterations: 8,
-            direct_iterations: 6,
-            stop_slack: 0.05,
-            direct_barrier_updates: 2,
-            direct_stop_slack: 0.01,
         }
     }
+}
+
+/// What one round runs with: the stage's settings, the tuning of this mesh's kind of
+/// round, and the round's own threshold and vertex rule.
+struct RoundPrm<'p> {
+    stage: &'p HighOrderParams,
+    tune: &'p RoundTuning,
+    /// This round's threshold (see [`HighOrderParams::reach`]).
+    threshold: f64,
+    /// This round's [`HighOrderParams::vertices_below`].
+    vertices_below: f64,
 }
 
 /// What the high-order stage did.
@@ -229,32 +239,23 @@ pub fn optimize_high_order(
     // Set once a round improved nothing with vertices held back: from then on vertices
     // may move in every patch below the threshold.
     let mut escalate = false;
-    // This mesh's tuning, staged or direct, resolved once.
-    let tuned = if direct {
-        HighOrderParams {
-            layers: prm.direct_layers,
-            rounds: prm.direct_rounds,
-            max_rounds: prm.direct_rounds,
-            iterations: prm.direct_iterations,
-            stop_slack: prm.direct_stop_slack,
-            barrier_updates: prm.direct_barrier_updates,
-            ..prm.clone()
-        }
+    // This mesh's kind of rounds, staged or direct, resolved once.
+    let (tune, max_rounds) = if direct {
+        (&prm.direct, prm.direct.rounds)
     } else {
-        HighOrderParams {
-            max_rounds: prm.max_rounds.max(prm.rounds),
-            ..prm.clone()
-        }
+        (&prm.staged, prm.max_rounds.max(prm.staged.rounds))
     };
     // The last round's aim; reaching it means the reach, not the optimizer, held the
     // worst element back, so another round can lift it further.
     let mut aim = f64::INFINITY;
-    for round in 0..tuned.max_rounds {
+    for round in 0..max_rounds {
         let (worst, invalid, _) = census(&sj);
-        if round >= tuned.rounds && worst < aim && invalid == 0 {
+        if round >= tune.rounds && worst < aim && invalid == 0 {
             break;
         }
-        let rp = HighOrderParams {
+        let rp = RoundPrm {
+            stage: prm,
+            tune,
             vertices_below: if escalate {
                 prm.threshold
             } else {
@@ -265,11 +266,9 @@ pub fn optimize_high_order(
             } else {
                 prm.threshold.min(worst.max(0.0) + prm.reach)
             },
-            ..tuned.clone()
         };
-        let prm = &rp;
         let mut seeds: Vec<u32> = (0..ne as u32)
-            .filter(|&t| sj[t as usize] < prm.threshold)
+            .filter(|&t| sj[t as usize] < rp.threshold)
             .collect();
         if seeds.is_empty() {
             break;
@@ -288,7 +287,7 @@ pub fn optimize_high_order(
                 &adj,
                 bnd.n_surf,
                 s,
-                (prm.layers + round).min(prm.max_layers.max(prm.layers)),
+                (tune.layers + round).min(prm.max_layers.max(tune.layers)),
                 prm.move_vertices,
                 &mut marks,
             );
@@ -309,14 +308,14 @@ pub fn optimize_high_order(
             patches.push(p);
         }
         let colours = colour(&patches, ne);
-        let done = schedule::run_round(mesh, &patches, &colours, &mut sj, prm);
+        let done = schedule::run_round(mesh, &patches, &colours, &mut sj, &rp);
         st.patches += patches.len();
         st.patch_elements += patches.iter().map(|p| p.elems.len() as u64).sum::<u64>();
         st.element_evaluations += done.work;
         st.patches_improved += done.improved;
-        aim = prm.threshold;
+        aim = rp.threshold;
         if done.improved == 0 {
-            if escalate || prm.vertices_below >= prm.threshold || !prm.move_vertices {
+            if escalate || rp.vertices_below >= rp.threshold || !prm.move_vertices {
                 break;
             }
             escalate = true;
@@ -354,7 +353,7 @@ fn run_barrier(
     elems: &[PatchElem],
     v: &mut [f64],
     scale: &[f64],
-    prm: &HighOrderParams,
+    prm: &RoundPrm,
     lb: &mut Lbfgs,
     lone: &dyn Fn() -> bool,
 ) -> u64 {
@@ -371,7 +370,7 @@ fn run_barrier(
         return 0;
     }
     let mut u: Vec<f64> = v.iter().zip(scale).map(|(x, s)| x / s).collect();
-    for _ in 0..prm.barrier_updates {
+    for _ in 0..prm.tune.barrier_updates {
         obj.eps = if mmin == 0.0 {
             -0.1
         } else {
@@ -388,9 +387,15 @@ fn run_barrier(
             }
             val
         };
-        let target = prm.threshold + prm.stop_slack;
+        let target = prm.threshold + prm.tune.stop_slack;
         let mut reached = || last.get() >= target;
-        lb.minimize(&mut u, &mut f, prm.iterations, FIRST_STEP, &mut reached);
+        lb.minimize(
+            &mut u,
+            &mut f,
+            prm.tune.iterations,
+            FIRST_STEP,
+            &mut reached,
+        );
         // (The last evaluation may have been a rejected trial point.)
         unscale(&u, scale, v);
         let (new, ratio) = obj.min_measure(v);
@@ -513,7 +518,7 @@ struct PatchJob {
 }
 
 /// The inputs of patch `p` at node positions `x` and element scores `sj`.
-fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &HighOrderParams) -> PatchJob {
+fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &RoundPrm) -> PatchJob {
     let var_of = |n: u32| -> u32 { p.free.binary_search(&n).map_or(FIXED, |i| i as u32) };
     let mut elems = Vec::with_capacity(p.elems.len());
     let mut before_min = f64::INFINITY;
@@ -562,7 +567,7 @@ fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &HighOrderP
 /// for a poor patch), or below the patch's previous worst.
 fn run_patch(
     job: PatchJob,
-    prm: &HighOrderParams,
+    prm: &RoundPrm,
     lb: &mut Lbfgs,
     lone: &dyn Fn() -> bool,
 ) -> (Option<PatchResult>, u64) {
@@ -608,15 +613,16 @@ fn run_patch(
     }
     // Stage B: vertices too.
     let has_vertex = elems.iter().any(|e| e.var[..4].iter().any(|&i| i != FIXED));
-    if prm.move_vertices && has_vertex && best_min < prm.threshold.min(prm.vertices_below) {
+    if prm.stage.move_vertices && has_vertex && best_min < prm.threshold.min(prm.vertices_below) {
         let vb = v.clone();
         work += run_barrier(&elems, &mut v, &scale, prm, lb, lone);
         if v != vb {
             let (lo, sk) = evaluate(&elems, &v, prm.threshold, true, &mut scores, lone);
-            let cap = if before_min < prm.rescue_below {
-                prm.max_skewness_rescue
+            let stage = prm.stage;
+            let cap = if before_min < stage.rescue_below {
+                stage.max_skewness_rescue
             } else {
-                prm.max_skewness
+                stage.max_skewness
             };
             // Corner skewness before (`x` of a patch element holds its starting nodes).
             let before_skew = elems.iter().map(|e| skew(&e.x)).fold(0.0f64, f64::max);
@@ -743,9 +749,13 @@ mod tests {
         // The tangle starts poor (below reach_below): the staged rounds apply. With none
         // planned, only invalid elements keep rounds going, and they stop once all are
         // valid.
+        let d = HighOrderParams::default();
         let only_invalid = HighOrderParams {
-            rounds: 0,
-            ..HighOrderParams::default()
+            staged: RoundTuning {
+                rounds: 0,
+                ..d.staged.clone()
+            },
+            ..d.clone()
         };
         let mut a = m.clone();
         let st = optimize_high_order(&mut a, &bnd, &only_invalid);
@@ -760,9 +770,8 @@ mod tests {
         assert!(uncertified(&a).is_empty(), "{st:?}");
         // Without the extension nothing runs.
         let none = HighOrderParams {
-            rounds: 0,
             max_rounds: 0,
-            ..HighOrderParams::default()
+            ..only_invalid.clone()
         };
         let mut b = m.clone();
         let st = optimize_high_order(&mut b, &bnd, &none);

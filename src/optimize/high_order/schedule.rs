@@ -13,7 +13,7 @@
 
 use super::lbfgs::Lbfgs;
 use super::patch::Patch;
-use super::{prepare, run_patch, HighOrderParams, PatchResult};
+use super::{prepare, run_patch, PatchResult, RoundPrm};
 use crate::geom::vec3::P3;
 use crate::mesh::TetMesh;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -87,7 +87,7 @@ struct Round<'a, 'm> {
     tets: &'a [[u32; 10]],
     patches: &'a [Patch],
     dependents: Vec<Vec<u32>>,
-    prm: &'a HighOrderParams,
+    prm: &'a RoundPrm<'a>,
     state: RwLock<State<'m>>,
     progress: Mutex<Progress>,
     /// Patches spawned and not yet done (running or queued).
@@ -101,7 +101,7 @@ pub(super) fn run_round(
     patches: &[Patch],
     colours: &[u32],
     sj: &mut [f64],
-    prm: &HighOrderParams,
+    prm: &RoundPrm,
 ) -> RoundDone {
     let deps = dependencies(patches, colours, sj.len());
     let mut dependents = vec![Vec::new(); patches.len()];
@@ -204,7 +204,7 @@ mod tests {
         patches: &[Patch],
         colours: &[u32],
         sj: &mut [f64],
-        prm: &HighOrderParams,
+        prm: &RoundPrm,
     ) -> (usize, u64) {
         let (mut improved, mut work) = (0, 0);
         let ncol = colours.iter().copied().max().map_or(0, |c| c + 1);
@@ -235,7 +235,13 @@ mod tests {
         let c = cube(4, 0.08);
         let base = c.p2_perturbed(5, 0.05);
         let adj = NodeElems::new(&base);
-        let prm = HighOrderParams::default();
+        let stage = crate::optimize::HighOrderParams::default();
+        let prm = RoundPrm {
+            stage: &stage,
+            tune: &stage.staged,
+            threshold: stage.threshold,
+            vertices_below: stage.vertices_below,
+        };
         let ne = base.tets.len();
         let mut sj0 = vec![0.0; ne];
         let all: Vec<u32> = (0..ne as u32).collect();
