@@ -8,6 +8,7 @@
 //! the minimum quality of the tets it touches.
 
 use super::mesh::{face_opposite, opposite_edge, LinMesh};
+use super::quality::{halved_angle_bound, BOUND_MARGIN};
 
 /// Largest edge ring edge removal tries.
 pub(super) const MAX_RING: usize = 10;
@@ -57,19 +58,19 @@ pub(super) fn flip23(m: &mut LinMesh, t: u32, k: usize, eps: f64) -> bool {
     true
 }
 
-/// Try to remove the interior edge (a, b): replace the n tets around it by the 2n − 4
-/// tets of the best triangulation of its ring (3 ≤ n ≤ [`MAX_RING`]). Applied (returns
-/// true) only when that raises the minimum quality by more than `eps`.
-pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut FlipScratch) -> bool {
+/// The tets around the interior edge (a, b) into `s.ts` and its ring into `s.ring`,
+/// oriented so that every old tet is (a, b, r_i, r_i+1); returns their minimum quality.
+/// `None` for a boundary edge, a ring outside 3..=[`MAX_RING`], or one not closed (a
+/// boundary or non-manifold edge).
+fn load_ring(m: &LinMesh, a: u32, b: u32, s: &mut FlipScratch) -> Option<f64> {
     if m.bnd.is_boundary_edge(a, b) {
-        return false;
+        return None;
     }
     m.edge_tets(a, b, &mut s.ts);
     let n = s.ts.len();
     if !(3..=MAX_RING).contains(&n) {
-        return false;
+        return None;
     }
-    // The ring, oriented so that every old tet is (a, b, r_i, r_{i+1}).
     s.pairs.clear();
     let mut old = f64::INFINITY;
     for &t in &s.ts {
@@ -80,14 +81,39 @@ pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut Fli
     let mut cur = s.pairs[0].0;
     for _ in 0..n {
         s.ring.push(cur);
-        match s.pairs.iter().find(|p| p.0 == cur) {
-            Some(p) => cur = p.1,
-            None => return false,
-        }
+        cur = s.pairs.iter().find(|p| p.0 == cur)?.1;
     }
-    if cur != s.ring[0] {
-        return false; // not a closed ring: a boundary or non-manifold edge
+    (cur == s.ring[0]).then_some(old)
+}
+
+/// An upper bound on the minimum quality of any triangulation edge removal can put in
+/// place of the tets around (a, b) with ring `ring`: each ring edge (r_i, r_i+1) is an
+/// edge of one triangle of the ring's triangulation, whose two new tets (one on a's
+/// side, one on b's) split the old tet (a, b, r_i, r_i+1) along it
+/// ([`halved_angle_bound`]). On the screw it rules out 257 of the 462 removals that got
+/// this far, 11,933 of 19,563 on the hinge, before their dynamic program.
+fn ring_bound(m: &LinMesh, a: u32, b: u32, ring: &[u32]) -> f64 {
+    let (pa, pb) = (m.pts[a as usize], m.pts[b as usize]);
+    let n = ring.len();
+    (0..n)
+        .map(|i| {
+            let (u, v) = (ring[i], ring[(i + 1) % n]);
+            halved_angle_bound(m.pts[u as usize], m.pts[v as usize], pa, pb)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Try to remove the interior edge (a, b): replace the n tets around it by the 2n − 4
+/// tets of the best triangulation of its ring (3 ≤ n ≤ [`MAX_RING`]). Applied (returns
+/// true) only when that raises the minimum quality by more than `eps`.
+pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut FlipScratch) -> bool {
+    let Some(old) = load_ring(m, a, b, s) else {
+        return false;
+    };
+    if ring_bound(m, a, b, &s.ring) + BOUND_MARGIN <= old + eps {
+        return false;
     }
+    let n = s.ring.len();
     // Quality of the pair of tets on ring triangle (i, k, j), i < k < j: the tet
     // (r_i, r_k, r_j, b) and (r_i, r_j, r_k, a) are positive for a convex ring. Values at
     // or below the floor `old + eps` may be any such value ([`LinMesh::quality_of_above`]):
@@ -162,4 +188,69 @@ pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut Fli
         s.stack.push((k, j));
     }
     true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::shape::TET10_EDGES;
+    use crate::optimize::linear::quality::ElementQuality;
+    use crate::optimize::testmesh::cube;
+    use rand::{Rng, SeedableRng};
+
+    /// Every edge removal of a jittered cube, made whatever it gives (a minimum to beat of
+    /// old − 10), leaves new tets whose minimum is at most `ring_bound`, and the bound
+    /// would have ruled out some of them (below the old minimum).
+    #[test]
+    fn no_edge_removal_beats_its_bound() {
+        let c = cube(3, 0.08);
+        let bnd = c.boundary();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(4);
+        let mut pts = c.pts.clone();
+        for p in pts.iter_mut().skip(c.n_surf) {
+            for x in p.iter_mut() {
+                *x += rng.random_range(-0.1..0.1);
+            }
+        }
+        let mut edges: Vec<(u32, u32)> = c
+            .tets
+            .iter()
+            .flat_map(|t| TET10_EDGES.map(|[i, j]| (t[i].min(t[j]), t[i].max(t[j]))))
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        let (mut removed, mut below) = (0, 0);
+        for (a, b) in edges {
+            let mut m = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+            let mut s = FlipScratch::default();
+            let Some(old) = load_ring(&m, a, b, &mut s) else {
+                continue;
+            };
+            let bound = ring_bound(&m, a, b, &s.ring);
+            let before: std::collections::HashSet<[u32; 4]> =
+                m.tets.iter().map(|t| sorted(*t)).collect();
+            if !remove_edge(&mut m, a, b, -10.0, &mut s) {
+                continue;
+            }
+            let new_min = (0..m.tets.len())
+                .filter(|&t| m.alive(t as u32) && !before.contains(&sorted(m.tets[t])))
+                .map(|t| m.q[t])
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                new_min <= bound + 1e-12,
+                "({a}, {b}): {new_min} > bound {bound}"
+            );
+            removed += 1;
+            below += usize::from(bound < old);
+        }
+        assert!(
+            removed > 50 && below > 10,
+            "{removed} removals, {below} ruled out by the bound"
+        );
+    }
+
+    fn sorted(mut t: [u32; 4]) -> [u32; 4] {
+        t.sort_unstable();
+        t
+    }
 }

@@ -8,7 +8,9 @@
 
 use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds, LinearJacobian};
 use crate::geom::predicates::orient3d;
-use crate::geom::quality::{dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG};
+use crate::geom::quality::{
+    dihedral_at_edge, dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG,
+};
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
 use crate::optimize::dual::{dcross, ddot, dsub, D3, DP};
@@ -109,6 +111,21 @@ impl ElementQuality {
         }
         1.0 - s
     }
+}
+
+/// Slack of [`halved_angle_bound`] against the minimum an operation must beat: far
+/// above the rounding of either (about 1e-15), so an operation that could succeed is
+/// never ruled out.
+pub(super) const BOUND_MARGIN: f64 = 1e-9;
+
+/// An upper bound on the quality of the worse of two positive tets that split the tet
+/// (u, v, a, b) along its edge (u, v) (by a plane through u, v and any point between
+/// a's and b's sides, as an edge split or an edge removal does): their dihedral angles at
+/// (u, v) add up to the old tet's there, so one is at most half of it, and a tet's
+/// quality is at most θmin / θe (1 − equiangular skewness, paper eq. 2; a curved part
+/// only lowers it). A non-positive tet scores −∞, below any bound.
+pub(super) fn halved_angle_bound(u: P3, v: P3, a: P3, b: P3) -> f64 {
+    dihedral_at_edge(u, v, a, b) / (2.0 * EQUIANGULAR_DIHEDRAL_DEG)
 }
 
 /// The twelve smooth pieces whose minimum is 1 − skewness: for each dihedral angle θ
