@@ -54,6 +54,33 @@ impl CubeMesh {
     }
 }
 
+/// The points of `c` with every interior vertex moved by a random offset of up to `amp`
+/// per coordinate (seeded), for the linear stage's operations to work on.
+pub(crate) fn jittered(c: &CubeMesh, seed: u64, amp: f64) -> Vec<P3> {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut pts = c.pts.clone();
+    for p in pts.iter_mut().skip(c.n_surf) {
+        for x in p.iter_mut() {
+            *x += rng.random_range(-amp..amp);
+        }
+    }
+    pts
+}
+
+/// The edges of `tets`, each once as (smaller id, larger id), sorted.
+pub(crate) fn edges(tets: &[[u32; 4]]) -> Vec<(u32, u32)> {
+    let mut e: Vec<(u32, u32)> = tets
+        .iter()
+        .flat_map(|t| {
+            crate::geom::shape::TET10_EDGES.map(|[i, j]| (t[i].min(t[j]), t[i].max(t[j])))
+        })
+        .collect();
+    e.sort_unstable();
+    e.dedup();
+    e
+}
+
 /// The unit cube in `k^3` cells, each split into six tets around its main diagonal.
 /// `bulge` pushes every boundary mid node outward by `bulge` times its edge length
 /// along the face normal (0: straight boundary).

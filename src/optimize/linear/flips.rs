@@ -193,10 +193,8 @@ pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut Fli
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::shape::TET10_EDGES;
     use crate::optimize::linear::quality::ElementQuality;
-    use crate::optimize::testmesh::cube;
-    use rand::{Rng, SeedableRng};
+    use crate::optimize::testmesh::{cube, edges, jittered};
 
     /// Every edge removal of a jittered cube, made whatever it gives (a minimum to beat of
     /// old − 10), leaves new tets whose minimum is at most `ring_bound`, and the bound
@@ -205,22 +203,9 @@ mod tests {
     fn no_edge_removal_beats_its_bound() {
         let c = cube(3, 0.08);
         let bnd = c.boundary();
-        let mut rng = rand::rngs::StdRng::seed_from_u64(4);
-        let mut pts = c.pts.clone();
-        for p in pts.iter_mut().skip(c.n_surf) {
-            for x in p.iter_mut() {
-                *x += rng.random_range(-0.1..0.1);
-            }
-        }
-        let mut edges: Vec<(u32, u32)> = c
-            .tets
-            .iter()
-            .flat_map(|t| TET10_EDGES.map(|[i, j]| (t[i].min(t[j]), t[i].max(t[j]))))
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
+        let pts = jittered(&c, 4, 0.1);
         let (mut removed, mut below) = (0, 0);
-        for (a, b) in edges {
+        for (a, b) in edges(&c.tets) {
             let mut m = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
             let mut s = FlipScratch::default();
             let Some(old) = load_ring(&m, a, b, &mut s) else {

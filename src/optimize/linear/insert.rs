@@ -7,8 +7,6 @@
 use super::mesh::{opposite_edge, LinMesh};
 use super::quality::{halved_angle_bound, BOUND_MARGIN};
 use super::smooth::{smooth_vertex, SmoothParams, SmoothScratch};
-#[cfg(test)]
-use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::mid;
 
 /// Scratch buffers of the insertion.
@@ -129,8 +127,7 @@ pub(super) fn split_edge(
 mod tests {
     use super::*;
     use crate::optimize::linear::quality::ElementQuality;
-    use crate::optimize::testmesh::cube;
-    use rand::{Rng, SeedableRng};
+    use crate::optimize::testmesh::{cube, edges, jittered};
 
     /// Every split of a jittered cube, its new vertex smoothed and the split kept whatever
     /// it gives (a minimum to beat of old − 10), ends at or below `split_bound`, and the
@@ -139,22 +136,9 @@ mod tests {
     fn no_split_beats_its_bound() {
         let c = cube(3, 0.08);
         let bnd = c.boundary();
-        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
-        let mut pts = c.pts.clone();
-        for p in pts.iter_mut().skip(c.n_surf) {
-            for x in p.iter_mut() {
-                *x += rng.random_range(-0.1..0.1);
-            }
-        }
-        let mut edges: Vec<(u32, u32)> = c
-            .tets
-            .iter()
-            .flat_map(|t| TET10_EDGES.map(|[i, j]| (t[i].min(t[j]), t[i].max(t[j]))))
-            .collect();
-        edges.sort_unstable();
-        edges.dedup();
+        let pts = jittered(&c, 3, 0.1);
         let (mut kept, mut below) = (0, 0);
-        for (a, b) in edges {
+        for (a, b) in edges(&c.tets) {
             let mut m = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
             let mut ts = Vec::new();
             m.edge_tets(a, b, &mut ts);
