@@ -49,7 +49,18 @@ impl<'a> LinMesh<'a> {
         bnd: &'a Boundary,
         eq: ElementQuality,
     ) -> Self {
-        let mut vt = vec![Vec::new(); pts.len()];
+        // Each star allocated once at its final size (about 20 tets; grown push by push,
+        // most were reallocated three times).
+        let mut deg = vec![0u32; pts.len()];
+        for t in &tets {
+            for &v in t {
+                deg[v as usize] += 1;
+            }
+        }
+        let mut vt: Vec<Vec<u32>> = deg
+            .iter()
+            .map(|&d| Vec::with_capacity(d as usize))
+            .collect();
         for (i, t) in tets.iter().enumerate() {
             for &v in t {
                 vt[v as usize].push(i as u32);
