@@ -6,6 +6,7 @@
 //! create one); a non-positive tet, or one no placement of its interior mid nodes can make
 //! valid, scores −∞.
 
+use super::mesh::opposite_edge;
 use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds, LinearJacobian};
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{
@@ -113,19 +114,33 @@ impl ElementQuality {
     }
 }
 
-/// Slack of [`halved_angle_bound`] against the minimum an operation must beat: far
-/// above the rounding of either (about 1e-15), so an operation that could succeed is
-/// never ruled out.
-pub(super) const BOUND_MARGIN: f64 = 1e-9;
+/// Slack of [`ruled_out`]: far above the rounding of a bound or a minimum (about
+/// 1e-15), so an operation that could succeed is never ruled out.
+const BOUND_MARGIN: f64 = 1e-9;
 
-/// An upper bound on the quality of the worse of two positive tets that split the tet
-/// (u, v, a, b) along its edge (u, v) (by a plane through u, v and any point between
-/// a's and b's sides, as an edge split or an edge removal does): their dihedral angles at
-/// (u, v) add up to the old tet's there, so one is at most half of it, and a tet's
-/// quality is at most θmin / θe (1 − equiangular skewness, paper eq. 2; a curved part
-/// only lowers it). A non-positive tet scores −∞, below any bound.
-pub(super) fn halved_angle_bound(u: P3, v: P3, a: P3, b: P3) -> f64 {
-    dihedral_at_edge(u, v, a, b) / (2.0 * EQUIANGULAR_DIHEDRAL_DEG)
+/// An upper bound on the minimum quality of tets that replace the tets `ts` around the
+/// edge (a, b) by cutting each, (a, b, u, v), along its edge (u, v) opposite (a, b): as an
+/// edge split does (the new vertex lies on every cutting plane) and an edge removal does
+/// (each ring edge (u, v) is an edge of one triangle of the ring's triangulation, whose
+/// two new tets, one on a's side and one on b's, cut the old tet along it). The dihedral
+/// angles of the two positive tets of a cut add up, at (u, v), to the old tet's there, so
+/// one of them has at most half of it; and a tet's quality is at most θmin / θe
+/// (1 − equiangular skewness, paper eq. 2; a curved part only lowers it). A non-positive
+/// tet scores −∞, below any bound.
+pub(super) fn cut_bound(pts: &[P3], tets: &[[u32; 4]], a: u32, b: u32, ts: &[u32]) -> f64 {
+    let (pa, pb) = (pts[a as usize], pts[b as usize]);
+    ts.iter()
+        .map(|&t| {
+            let (u, v) = opposite_edge(tets[t as usize], a, b);
+            dihedral_at_edge(pts[u as usize], pts[v as usize], pa, pb)
+                / (2.0 * EQUIANGULAR_DIHEDRAL_DEG)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Whether `bound` (a [`cut_bound`]) rules out a minimum above `to_beat`.
+pub(super) fn ruled_out(bound: f64, to_beat: f64) -> bool {
+    bound + BOUND_MARGIN <= to_beat
 }
 
 /// The twelve smooth pieces whose minimum is 1 − skewness: for each dihedral angle θ
