@@ -109,6 +109,118 @@ struct Cand {
 }
 
 const NEW: u32 = u32::MAX;
+
+/// The ideal apex of one front face and the sizes it was measured with.
+struct ApexFrame {
+    /// The face's corners.
+    fp: [P3; 3],
+    /// Its centroid and inward unit normal.
+    c: P3,
+    n: P3,
+    /// The size field at the centroid (this attempt's scale applied).
+    l_field: f64,
+    /// The target edge length: the field, kept within 0.55-1.8 times the face's mean edge.
+    target: f64,
+    /// The regular-tet height of `target`, and the ideal apex at that height.
+    h: f64,
+    ideal: P3,
+}
+
+/// The shape floors a relaxation level ranks candidates with.
+#[derive(Clone, Copy)]
+enum Floors {
+    /// `Options::min_dihedral_deg` and `Options::max_skewness`.
+    Options,
+    /// A third of the dihedral floor, skewness up to 0.97.
+    Relaxed,
+    /// None: every candidate is kept, even one whose quality is undefined.
+    None,
+    /// None, but a candidate whose quality is undefined (NaN) is dropped.
+    NoneScored,
+}
+
+/// The floor on the angle between a new edge and a nearby front face.
+#[derive(Clone, Copy)]
+enum GapFloor {
+    /// `Options::min_edge_face_angle_deg` divided by this.
+    Options(f64),
+    /// This many degrees.
+    Degrees(f64),
+}
+
+/// What one relaxation level of [`Mesher::advance`] allows. A face is tried at level 0
+/// first; each failure raises its level (up to 2) for the next time it is popped; level 3
+/// is the late resort after local remeshing has not helped.
+struct Relaxation {
+    /// Candidate vertices within this many `alpha * h` of the ideal apex.
+    search_radius: f64,
+    /// New points keep this far from front vertices, as a fraction of the *field* size,
+    /// so a pocket of small faces cannot breed ever smaller elements.
+    new_point_spacing: f64,
+    /// Heights of the new points tried, as fractions of the ideal height.
+    new_point_heights: &'static [f64],
+    /// Shape floors for ranking.
+    shape_floors: Floors,
+    /// Edge/face angle floor in the validity test.
+    gap_floor: GapFloor,
+    /// Proximity floors (fractions of the target size): a new point, an existing vertex.
+    proximity: (f64, f64),
+    /// A candidate that fails only the look-ahead or the boundary gap floor is taken when
+    /// nothing else passes.
+    fallback_ok: bool,
+    /// A linear-valid tet whose P2 Jacobian is not positive is taken when it has a free
+    /// mid node for the optimizer to move (the look-ahead and the boundary gap floor are
+    /// then waived).
+    p2_invalid_ok: bool,
+}
+
+/// The relaxation levels, strictest first.
+const RELAXATION: [Relaxation; 4] = [
+    // 0: the paper's step, the options' floors.
+    Relaxation {
+        search_radius: 1.0,
+        new_point_spacing: 0.45,
+        new_point_heights: &[1.0],
+        shape_floors: Floors::Options,
+        gap_floor: GapFloor::Options(1.0),
+        proximity: (0.35, 0.35),
+        fallback_ok: false,
+        p2_invalid_ok: false,
+    },
+    // 1: twice the search radius, a lower new point, floors relaxed.
+    Relaxation {
+        search_radius: 2.0,
+        new_point_spacing: 0.35,
+        new_point_heights: &[1.0, 0.7],
+        shape_floors: Floors::Relaxed,
+        gap_floor: GapFloor::Options(2.5),
+        proximity: (0.2, 0.2),
+        fallback_ok: false,
+        p2_invalid_ok: false,
+    },
+    // 2: any valid tet; a look-ahead failure as a fallback.
+    Relaxation {
+        search_radius: 3.0,
+        new_point_spacing: 0.25,
+        new_point_heights: &[1.0, 0.7, 0.5],
+        shape_floors: Floors::None,
+        gap_floor: GapFloor::Degrees(1.0),
+        proximity: (0.12, 0.0),
+        fallback_ok: true,
+        p2_invalid_ok: false,
+    },
+    // 3: late resort, a tet for the high-order optimizer to untangle.
+    Relaxation {
+        search_radius: 3.0,
+        new_point_spacing: 0.25,
+        new_point_heights: &[1.0, 0.7, 0.5],
+        shape_floors: Floors::NoneScored,
+        gap_floor: GapFloor::Degrees(1.0),
+        proximity: (0.12, 0.0),
+        fallback_ok: false,
+        p2_invalid_ok: true,
+    },
+];
 /// Smallest wedge a new face may leave against a boundary face at any relaxation level: a
 /// thinner one could only be closed by a flat tet with a curved face, which is invalid
 /// on concave boundaries, and boundary faces can never be remeshed.
@@ -555,8 +667,40 @@ impl<'a> Mesher<'a> {
         }
     }
 
-    /// Try to build a tet on front face `fid` at relaxation `level`. True on success.
+    /// Try to build a tet on front face `fid` at relaxation `level` (an index into
+    /// [`RELAXATION`]). True on success. Three stages: [`Mesher::gather`] the candidate
+    /// apexes, [`Mesher::rank`] them (Algorithm 2), [`Mesher::accept`] the first that
+    /// passes the exact and certified tests.
     fn advance(&mut self, fid: u32, level: u8) -> bool {
+        let r = &RELAXATION[level as usize];
+        let frame = self.apex_frame(fid);
+        if !self.gather(fid, &frame, r) {
+            return false;
+        }
+        let mut cands = std::mem::take(&mut self.cands);
+        self.rank(&mut cands, &frame, r);
+        let chosen = self.accept(fid, &frame, r, &cands);
+        self.cands = cands;
+        let Some(cd) = chosen else {
+            return false;
+        };
+        let f = self.faces[fid as usize];
+        let apex = if cd.id == NEW {
+            self.stats.new_vertices += 1;
+            self.new_point(cd.p)
+        } else {
+            cd.id
+        };
+        // (The quality measured above, of these corners in this order; NaN was scored -1.)
+        let q = if cd.q >= 0.0 { cd.q } else { f64::NAN };
+        self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid, q);
+        true
+    }
+
+    /// Where the ideal apex of front face `fid` lies: the regular-tet height of the
+    /// target size along the face's inward normal (the curved face's tangent-plane normal
+    /// on a boundary face).
+    fn apex_frame(&mut self, fid: u32) -> ApexFrame {
         let f = self.faces[fid as usize];
         let fp = self.face_pts(fid);
         let c = centroid3(fp[0], fp[1], fp[2]);
@@ -578,14 +722,26 @@ impl<'a> Mesher<'a> {
         self.faces[fid as usize].dnear = dnear;
         let target = l_field.clamp(0.55 * lf, 1.8 * lf);
         let h = regular_height(target);
-        let a = axpy(c, h, n);
-        let (radius, min_new_dist) = match level {
-            // New points keep away from existing ones by a fraction of the *field* size,
-            // so a pocket of small faces cannot breed ever smaller elements.
-            0 => (self.alpha * h, 0.45 * l_field),
-            1 => (2.0 * self.alpha * h, 0.35 * l_field),
-            _ => (3.0 * self.alpha * h, 0.25 * l_field),
-        };
+        ApexFrame {
+            fp,
+            c,
+            n,
+            l_field,
+            target,
+            h,
+            ideal: axpy(c, h, n),
+        }
+    }
+
+    /// Gather the candidate apexes of face `fid` into `self.cands`: front vertices near
+    /// the ideal point in front of the face, the apexes of the faces across its edges,
+    /// and new points on the normal. False when there is none.
+    fn gather(&mut self, fid: u32, fr: &ApexFrame, r: &Relaxation) -> bool {
+        let f = self.faces[fid as usize];
+        let fp = fr.fp;
+        let (a, h) = (fr.ideal, fr.h);
+        let radius = r.search_radius * self.alpha * h;
+        let min_new_dist = r.new_point_spacing * fr.l_field;
         // Candidate existing vertices.
         let mut found = std::mem::take(&mut self.found);
         self.front_vertices_within(a, radius, &mut found);
@@ -633,18 +789,13 @@ impl<'a> Mesher<'a> {
             }
         }
         // New points: the ideal one, and lower ones when relaxing.
-        let heights: &[f64] = match level {
-            0 => &[1.0],
-            1 => &[1.0, 0.7],
-            _ => &[1.0, 0.7, 0.5],
-        };
-        for &s in heights {
-            let p = axpy(c, s * h, n);
+        for &s in r.new_point_heights {
+            let p = axpy(fr.c, s * h, fr.n);
             // Distance to existing front vertices near the new point.
             let dmin = if s == 1.0 {
                 nearest_existing
             } else {
-                self.nearest_front_vertex(p, target)
+                self.nearest_front_vertex(p, fr.target)
             };
             if dmin >= min_new_dist {
                 self.cands.push(Cand {
@@ -655,36 +806,31 @@ impl<'a> Mesher<'a> {
                 });
             }
         }
-        if self.cands.is_empty() {
-            return false;
-        }
-        // Quality of each candidate (cheap, floating point).
-        let (min_dih, max_skew, min_gap) = match level {
-            0 => (
-                self.opts.min_dihedral_deg,
-                self.opts.max_skewness,
-                self.opts.min_edge_face_angle_deg,
-            ),
-            1 => (
-                self.opts.min_dihedral_deg / 3.0,
-                0.97,
-                self.opts.min_edge_face_angle_deg / 2.5,
-            ),
-            _ => (0.0, 1.0, 1.0),
+        !self.cands.is_empty()
+    }
+
+    /// Score the candidates (1 - skewness, cheap floating point), drop those below the
+    /// level's floors, and order them (Algorithm 2): best quality first; if the best is
+    /// a new point, existing vertices closer than h to the ideal point come first,
+    /// nearest first.
+    fn rank(&self, cands: &mut Vec<Cand>, fr: &ApexFrame, r: &Relaxation) {
+        let fp = fr.fp;
+        let (min_dih, max_skew) = match r.shape_floors {
+            Floors::Options => (self.opts.min_dihedral_deg, self.opts.max_skewness),
+            Floors::Relaxed => (self.opts.min_dihedral_deg / 3.0, 0.97),
+            Floors::None | Floors::NoneScored => (0.0, 1.0),
         };
-        let mut cands = std::mem::take(&mut self.cands);
         cands.retain_mut(|cd| {
             let tp = [fp[0], fp[1], fp[2], cd.p];
             let (mn, mx) = dihedral_extremes(&tp);
             let sk = skewness_from_extremes(mn, mx);
             cd.q = if sk.is_nan() { -1.0 } else { 1.0 - sk };
-            level == 2 || (mn >= min_dih && sk <= max_skew)
+            matches!(r.shape_floors, Floors::None) || (mn >= min_dih && sk <= max_skew)
         });
-        // Order (Algorithm 2): best quality first; if the best is a new point, existing
-        // vertices closer than h to the ideal point come first, nearest first.
         cands.sort_by(|x, y| y.q.total_cmp(&x.q).then(x.id.cmp(&y.id)));
         if let Some(first) = cands.first() {
             if first.id == NEW {
+                let h = fr.h;
                 let mut close: Vec<Cand> = cands
                     .iter()
                     .filter(|c| c.id != NEW && c.dist_a < h)
@@ -698,20 +844,28 @@ impl<'a> Mesher<'a> {
                         .cloned()
                         .collect();
                     close.extend(rest);
-                    cands = close;
+                    *cands = close;
                 }
             }
         }
+    }
+
+    /// The first ranked candidate whose tet passes the exact validity test with the
+    /// level's proximity and gap floors, the certified P2 test, and the look-ahead; at
+    /// the levels that allow it, the first that failed only the look-ahead or the
+    /// boundary gap floor.
+    fn accept(&mut self, fid: u32, fr: &ApexFrame, r: &Relaxation, cands: &[Cand]) -> Option<Cand> {
+        let f = self.faces[fid as usize];
+        let fp = fr.fp;
+        let min_gap = match r.gap_floor {
+            GapFloor::Options(k) => self.opts.min_edge_face_angle_deg / k,
+            GapFloor::Degrees(d) => d,
+        };
         // Proximity floors: (new point, existing vertex). A new point never comes right
         // against the front, whatever the level: it would leave a sliver layer.
-        let (prox_new, prox_old) = match level {
-            0 => (0.35 * target, 0.35 * target),
-            1 => (0.2 * target, 0.2 * target),
-            _ => (0.12 * target, 0.0),
-        };
-        let mut chosen = None;
+        let (prox_new, prox_old) = (r.proximity.0 * fr.target, r.proximity.1 * fr.target);
         let mut fallback = None;
-        for cd in &cands {
+        for cd in cands {
             let apex = if cd.id == NEW {
                 validity::NEW_POINT
             } else {
@@ -738,15 +892,15 @@ impl<'a> Mesher<'a> {
             let mut p2_invalid = false;
             if let Some(x) = self.p2_nodes(t, &tp) {
                 if !curved_valid(&x) {
-                    // Last resort (level 3): a linear-valid tet whose P2 Jacobian is not
-                    // positive, if it has a free mid node the optimizer can move.
+                    // Last resort: a linear-valid tet whose P2 Jacobian is not positive,
+                    // if it has a free mid node the optimizer can move.
                     let free_edge = TET10_EDGES.iter().any(|[i, j]| {
                         let (a, b) = (t[*i], t[*j]);
                         !((a as usize) < self.n_surf
                             && (b as usize) < self.n_surf
                             && self.bedge_mid.contains_key(&(a.min(b), a.max(b))))
                     });
-                    if level < 3 || !free_edge {
+                    if !r.p2_invalid_ok || !free_edge {
                         continue;
                     }
                     p2_invalid = true;
@@ -762,11 +916,11 @@ impl<'a> Mesher<'a> {
                     break;
                 }
             }
-            if (!closable || thin_boundary_gap) && level < 3 {
-                // At level 2 a candidate that fails only the look-ahead or the boundary gap
-                // floor is still taken when nothing else passes: the wedge it leaves may
-                // close another way, and a stuck face certainly does not.
-                if level == 2 && fallback.is_none() && !p2_invalid {
+            if (!closable || thin_boundary_gap) && !r.p2_invalid_ok {
+                // A candidate that fails only the look-ahead or the boundary gap floor is
+                // still taken, where the level allows, when nothing else passes: the wedge
+                // it leaves may close another way, and a stuck face certainly does not.
+                if r.fallback_ok && fallback.is_none() && !p2_invalid {
                     fallback = Some(*cd);
                 }
                 continue;
@@ -774,23 +928,9 @@ impl<'a> Mesher<'a> {
             if p2_invalid {
                 self.stats.p2_invalid += 1;
             }
-            chosen = Some(*cd);
-            break;
+            return Some(*cd);
         }
-        self.cands = cands;
-        let Some(cd) = chosen.or(fallback) else {
-            return false;
-        };
-        let apex = if cd.id == NEW {
-            self.stats.new_vertices += 1;
-            self.new_point(cd.p)
-        } else {
-            cd.id
-        };
-        // (The quality measured above, of these corners in this order; NaN was scored -1.)
-        let q = if cd.q >= 0.0 { cd.q } else { f64::NAN };
-        self.insert_tet([f.v[0], f.v[1], f.v[2], apex], fid, q);
-        true
+        fallback
     }
 
     /// Can the thin wedge between front face `c[0..3]` and candidate tet `t` (apex

@@ -24,3 +24,4 @@ pub mod build;
 pub mod check;
 pub mod plot;
 pub mod quality;
+pub mod slivers;

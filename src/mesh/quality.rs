@@ -54,6 +54,8 @@ pub struct QualityReport {
     pub volume_curved: f64,
     /// Min/max/mean and histograms of each measure.
     pub quality: TetQualitySummary,
+    /// Tets with a dihedral angle below 10°, forced by the input's triangles or not.
+    pub slivers: super::slivers::SliverCensus,
 }
 
 impl QualityReport {
@@ -94,6 +96,7 @@ impl QualityReport {
             volume_linear: per.iter().map(|v| v.1).collect::<CompensatedSum>().value(),
             volume_curved: per.iter().map(|v| v.2).collect::<CompensatedSum>().value(),
             quality: summary,
+            slivers: super::slivers::census(m),
         }
     }
 }

@@ -1,0 +1,265 @@
+//! Corpus benchmark: curvetet against TetGen on every surface of a folder, in one run.
+//!
+//!     cargo bench --bench corpus                                  # ../shared/data/openscad
+//!     cargo bench --bench corpus -- --dir DIR --timeout 60 --only example002,offset
+//!     cargo bench --bench corpus -- --json corpus.json
+//!
+//! Per surface (every `.stl`, `.off`, `.obj`, `.ply` in the folder, by name):
+//! - curvetet: `curvetet mesh IN -o OUT.vtu --report R.json -q` with default options, killed
+//!   after `--timeout` seconds (default 60); wall time, tets, minimum dihedral angle,
+//!   certified min J / max J, and the sliver counts of the report when it has them;
+//! - TetGen:   `tetgen -pYqQ IN` (quality mesh, boundary kept) on the same file.
+//!
+//! Prints a table, the count meshed, the total time ratio (over the surfaces both meshed,
+//! and with failures counted at their time) and the worst per-surface ratio. The issue's
+//! targets: every surface meshed, corpus total at most 3x TetGen's, no surface above
+//! 10x TetGen's time + 0.5 s. Timing only; nothing is asserted (tests assert outcomes).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Args {
+    dir: PathBuf,
+    timeout: f64,
+    only: Vec<String>,
+    json: Option<PathBuf>,
+}
+
+fn parse_args() -> Args {
+    let mut a = Args {
+        dir: Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/openscad"),
+        timeout: 60.0,
+        only: Vec::new(),
+        json: None,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(x) = it.next() {
+        match x.as_str() {
+            "--dir" => a.dir = it.next().expect("--dir DIR").into(),
+            "--timeout" => a.timeout = it.next().and_then(|s| s.parse().ok()).expect("--timeout S"),
+            "--only" => {
+                a.only = it
+                    .next()
+                    .expect("--only A,B")
+                    .split(',')
+                    .map(str::to_string)
+                    .collect()
+            }
+            "--json" => a.json = Some(it.next().expect("--json FILE").into()),
+            _ => {} // cargo bench passes --bench
+        }
+    }
+    a
+}
+
+/// Wall time and exit (None: killed at the timeout) of `cmd`, output to `log`.
+fn run(cmd: &mut Command, log: &Path, timeout: f64) -> (f64, Option<i32>) {
+    cmd.stdin(Stdio::null())
+        .stdout(std::fs::File::create(log).expect("log"))
+        .stderr(std::fs::File::create(log.with_extension("err")).expect("log"));
+    let t0 = Instant::now();
+    let Ok(mut child) = cmd.spawn() else {
+        return (0.0, Some(-1));
+    };
+    loop {
+        if let Ok(Some(st)) = child.try_wait() {
+            return (t0.elapsed().as_secs_f64(), Some(st.code().unwrap_or(-1)));
+        }
+        if t0.elapsed().as_secs_f64() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            return (t0.elapsed().as_secs_f64(), None);
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+#[derive(Default, serde::Serialize)]
+struct Row {
+    name: String,
+    triangles: usize,
+    ct_secs: f64,
+    ct_outcome: String,
+    tets: usize,
+    min_dihedral: f64,
+    min_jac: f64,
+    slivers_forced: Option<u64>,
+    slivers_unforced: Option<u64>,
+    tg_secs: f64,
+    tg_ok: bool,
+}
+
+fn main() {
+    let a = parse_args();
+    let exe = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/release/curvetet");
+    let st = Command::new("cargo")
+        .args(["build", "--release", "--quiet", "--bin", "curvetet"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .status()
+        .expect("cargo");
+    assert!(st.success(), "cargo build failed");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&a.dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", a.dir.display()))
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let ext = p.extension().and_then(|x| x.to_str()).unwrap_or("");
+            ["stl", "off", "obj", "ply"].contains(&ext.to_ascii_lowercase().as_str())
+        })
+        .filter(|p| {
+            a.only.is_empty()
+                || a.only
+                    .iter()
+                    .any(|o| p.file_stem().unwrap().to_str() == Some(o))
+        })
+        .collect();
+    files.sort();
+    let tmp = std::env::temp_dir().join(format!("curvetet-corpus-{}", std::process::id()));
+    std::fs::create_dir_all(&tmp).expect("tmp");
+    let have_tetgen = Command::new("tetgen")
+        .arg("-h")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok();
+    println!(
+        "{:<22} {:>6} {:>9} {:>8} {:>7} {:>7} {:>8} {:>9} {:>7} {:>6}",
+        "surface",
+        "tris",
+        "curvetet",
+        "outcome",
+        "tets",
+        "min dih",
+        "min J",
+        "slivers",
+        "TetGen",
+        "ratio"
+    );
+    let mut rows = Vec::new();
+    for f in &files {
+        let name = f.file_stem().unwrap().to_string_lossy().to_string();
+        let mut r = Row {
+            name: name.clone(),
+            ..Default::default()
+        };
+        // TetGen reads ASCII OFF (not binary STL): the corners of what curvetet read.
+        let off = tmp.join(format!("{name}.off"));
+        if let Ok(s) = curvetet::io::read_any_surface(f, &Default::default()) {
+            r.triangles = s.triangles().len();
+            write_off(&s, &off);
+        }
+        let rep = tmp.join(format!("{name}.json"));
+        let _ = std::fs::remove_file(&rep);
+        let (t, code) = run(
+            Command::new(&exe).args([
+                "mesh".as_ref(),
+                f.as_os_str(),
+                "-q".as_ref(),
+                "-o".as_ref(),
+                tmp.join(format!("{name}.vtu")).as_os_str(),
+                "--report".as_ref(),
+                rep.as_os_str(),
+            ]),
+            &tmp.join(format!("{name}.log")),
+            a.timeout,
+        );
+        r.ct_secs = t;
+        r.ct_outcome = match code {
+            None => "timeout".into(),
+            Some(0) => "ok".into(),
+            Some(c) => format!("exit {c}"),
+        };
+        if code == Some(0) {
+            let j: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&rep).unwrap_or_default())
+                    .unwrap_or_default();
+            let q = &j["report"]["quality"];
+            r.tets = j["report"]["num_tets"].as_u64().unwrap_or(0) as usize;
+            r.min_dihedral = q["min_dihedral"]["min"].as_f64().unwrap_or(f64::NAN);
+            r.min_jac = q["scaled_jacobian_certified"]["min"]
+                .as_f64()
+                .unwrap_or(f64::NAN);
+            r.slivers_forced = j["report"]["slivers"]["forced"].as_u64();
+            r.slivers_unforced = j["report"]["slivers"]["unforced"].as_u64();
+        }
+        if have_tetgen {
+            let (t, code) = run(
+                Command::new("tetgen").arg("-pYqQ").arg(&off),
+                &tmp.join(format!("{name}.tetgen.log")),
+                a.timeout,
+            );
+            r.tg_secs = t;
+            r.tg_ok = code == Some(0);
+        }
+        let sl = match (r.slivers_forced, r.slivers_unforced) {
+            (Some(fo), Some(un)) => format!("{fo}/{un}"),
+            _ => "-".into(),
+        };
+        println!(
+            "{:<22} {:>6} {:>9.2} {:>8} {:>7} {:>7.2} {:>8.3} {:>9} {:>7.2} {:>6.1}",
+            r.name,
+            r.triangles,
+            r.ct_secs,
+            r.ct_outcome,
+            r.tets,
+            r.min_dihedral,
+            r.min_jac,
+            sl,
+            r.tg_secs,
+            r.ct_secs / r.tg_secs.max(1e-3)
+        );
+        if !r.tg_ok {
+            println!("  (TetGen failed on {name})");
+        }
+        rows.push(r);
+    }
+    let ok = rows.iter().filter(|r| r.ct_outcome == "ok").count();
+    let total_ct: f64 = rows.iter().map(|r| r.ct_secs).sum();
+    let total_tg: f64 = rows.iter().map(|r| r.tg_secs).sum();
+    let worst = rows
+        .iter()
+        .map(|r| (r.ct_secs / (10.0 * r.tg_secs + 0.5), r.name.as_str()))
+        .fold((0.0, ""), |a, b| if b.0 > a.0 { b } else { a });
+    let unforced: u64 = rows.iter().filter_map(|r| r.slivers_unforced).sum();
+    println!(
+        "meshed {ok} of {}; total {total_ct:.1} s vs TetGen {total_tg:.1} s (ratio {:.1}, target <= 3); \
+         worst time / (10 x TetGen + 0.5 s) = {:.2} ({}; target <= 1); unforced slivers {unforced}",
+        rows.len(),
+        total_ct / total_tg.max(1e-3),
+        worst.0,
+        worst.1
+    );
+    if let Some(j) = a.json {
+        std::fs::write(&j, serde_json::to_string_pretty(&rows).unwrap()).expect("json");
+    }
+    let _ = std::fs::remove_dir_all(&tmp);
+}
+
+/// The corners of a surface as ASCII OFF, with round-trip coordinates.
+fn write_off(s: &curvetet::Surface, off: &Path) {
+    use std::fmt::Write as _;
+    let nodes = s.nodes();
+    let tris = s.triangles();
+    let mut used = vec![u32::MAX; nodes.len()];
+    let mut pts = Vec::new();
+    for t in tris {
+        for &v in &t[..3] {
+            if used[v as usize] == u32::MAX {
+                used[v as usize] = pts.len() as u32;
+                pts.push(nodes[v as usize]);
+            }
+        }
+    }
+    let mut o = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
+    for p in &pts {
+        let _ = writeln!(o, "{:e} {:e} {:e}", p[0], p[1], p[2]);
+    }
+    for t in tris {
+        let _ = writeln!(
+            o,
+            "3 {} {} {}",
+            used[t[0] as usize], used[t[1] as usize], used[t[2] as usize]
+        );
+    }
+    std::fs::write(off, o).expect("off");
+}
