@@ -3,6 +3,7 @@
 //!     cargo bench --bench corpus                                  # ../shared/data/openscad
 //!     cargo bench --bench corpus -- --dir DIR --timeout 60 --only example002,offset
 //!     cargo bench --bench corpus -- --json corpus.json
+//!     CURVETET_EXE=/tmp/curvetet cargo bench --bench corpus   # measure that build
 //!
 //! Per surface (every `.stl`, `.off`, `.obj`, `.ply` in the folder, by name):
 //! - curvetet: `curvetet mesh IN -o OUT.vtu --report R.json -q` with default options, killed
@@ -92,13 +93,20 @@ struct Row {
 
 fn main() {
     let a = parse_args();
-    let exe = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/release/curvetet");
-    let st = Command::new("cargo")
-        .args(["build", "--release", "--quiet", "--bin", "curvetet"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .status()
-        .expect("cargo");
-    assert!(st.success(), "cargo build failed");
+    // $CURVETET_EXE: another build to measure (e.g. a copy, so that rebuilding the tree
+    // during a long run does not change the program under test).
+    let exe = match std::env::var_os("CURVETET_EXE") {
+        Some(e) => PathBuf::from(e),
+        None => {
+            let st = Command::new("cargo")
+                .args(["build", "--release", "--quiet", "--bin", "curvetet"])
+                .current_dir(env!("CARGO_MANIFEST_DIR"))
+                .status()
+                .expect("cargo");
+            assert!(st.success(), "cargo build failed");
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("target/release/curvetet")
+        }
+    };
     let mut files: Vec<PathBuf> = std::fs::read_dir(&a.dir)
         .unwrap_or_else(|e| panic!("{}: {e}", a.dir.display()))
         .filter_map(|e| e.ok().map(|e| e.path()))

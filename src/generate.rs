@@ -53,10 +53,27 @@ pub struct Generated {
     pub size: f64,
 }
 
-/// The size field of `surface` under `opts`.
+/// The largest uniform size the boundary of `surface` supports: twice its mean corner edge
+/// length. The front grows a layer at most 1.8 times its base face's size, and new points
+/// keep a fraction of the target size from the front; a target far above the boundary's
+/// edges leaves it without room for new points, so it crawls (the unit sphere of mean
+/// edge 0.2 meshes at size 0.4 at once, but not within a minute at size 1). A larger
+/// [`SizeMode::Fixed`] is clamped to this ([`size_field`]).
+pub fn supported_size(surface: &Surface) -> f64 {
+    let nodes = surface.nodes();
+    let edges = surface.edges();
+    let sum: f64 = edges
+        .iter()
+        .map(|e| crate::geom::vec3::dist(nodes[e.nodes[0] as usize], nodes[e.nodes[1] as usize]))
+        .sum();
+    2.0 * sum / edges.len().max(1) as f64
+}
+
+/// The size field of `surface` under `opts` (a fixed size above [`supported_size`] is
+/// clamped to it).
 pub fn size_field(surface: &Surface, opts: &Options) -> SizeField {
     match opts.size {
-        SizeMode::Fixed(l) => SizeField::Uniform(l),
+        SizeMode::Fixed(l) => SizeField::Uniform(l.min(supported_size(surface))),
         SizeMode::Uniform => {
             // Paper eq. 1: the regular tetrahedron on the mean curved triangle area.
             let n = surface.triangles().len().max(1) as f64;

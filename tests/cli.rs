@@ -216,6 +216,39 @@ fn size_from_is_an_option_and_in_the_report() {
     assert_eq!(out.status.code(), Some(2), "clap refuses the combination");
 }
 
+/// A uniform `--size` far above the boundary's edges (the unit sphere's mean edge is about
+/// 0.2) is clamped to twice the mean edge, with a warning, and the report gives the size
+/// used; a size below that is used as given.
+#[test]
+fn a_size_the_boundary_cannot_support_is_clamped_and_said() {
+    let s = data("sphere_p2.msh");
+    let o = tmp("sphere_size1.msh");
+    let report = tmp("sphere_size1.json");
+    let out = run(&[
+        "mesh",
+        s.to_str().unwrap(),
+        "-o",
+        o.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "-q",
+        "--size",
+        "1",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("--size 1 is more than the boundary supports"),
+        "{err}"
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let used = r["size"].as_f64().unwrap();
+    assert!(used > 0.3 && used < 0.5, "{used}");
+    let r = mesh_report(&s, "sphere_size03", &["--size", "0.3"]);
+    assert_eq!(r["size"].as_f64(), Some(0.3));
+}
+
 #[test]
 fn bad_options_and_missing_files_fail_clearly() {
     let s = data("sphere_p2.msh");

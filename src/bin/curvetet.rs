@@ -328,6 +328,15 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
         eprintln!("warning: {w}");
     }
     let opts = m.options();
+    if let SizeMode::Fixed(l) = opts.size {
+        let most = curvetet::generate::supported_size(surface);
+        if l > most {
+            eprintln!(
+                "warning: --size {l} is more than the boundary supports (twice its mean edge \
+                 length); meshing with size {most:.6}"
+            );
+        }
+    }
     let pb = progress_bar(m.quiet);
     let mut cb = |f: f64, stage: &str| {
         pb.set_message(stage.to_string());
