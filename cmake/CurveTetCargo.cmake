@@ -3,7 +3,8 @@
 #   CurveTet::curvetet_static  the static library, with the system libraries it needs
 # Both carry the include directory of curvetet.h. The library files are copied from cargo's
 # target directory into <build>/lib (the shared one under its SONAME, plus the
-# libcurvetet.so link), which is also what gets installed.
+# libcurvetet.so link), which is also what gets installed, and the command-line tool into
+# <build>/bin/curvetet (CURVETET_EXECUTABLE, installed into <prefix>/bin).
 
 if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
   message(FATAL_ERROR "curvetet's CMake build supports Linux only for now (library names, SONAME, system libraries)")
@@ -68,20 +69,23 @@ set(CURVETET_LIBRARY_DIR "${CMAKE_BINARY_DIR}/lib")
 set(CURVETET_STATIC_LIBRARY "${CURVETET_LIBRARY_DIR}/libcurvetet.a")
 set(CURVETET_SHARED_LIBRARY "${CURVETET_LIBRARY_DIR}/${CURVETET_SONAME}")
 set(CURVETET_SHARED_LINK "${CURVETET_LIBRARY_DIR}/libcurvetet.so")
-file(MAKE_DIRECTORY "${CURVETET_LIBRARY_DIR}")
+set(CURVETET_EXECUTABLE "${CMAKE_BINARY_DIR}/bin/curvetet")
+file(MAKE_DIRECTORY "${CURVETET_LIBRARY_DIR}" "${CMAKE_BINARY_DIR}/bin")
 
 # Always ask cargo (it knows the Rust dependencies exactly and does nothing when the
 # library is up to date); copy only when the files changed, so C targets relink only then.
 add_custom_target(curvetet_cargo ALL
   COMMAND "${CMAKE_COMMAND}" -E env "CARGO_TARGET_DIR=${CURVETET_CARGO_TARGET_DIR}"
-          "${CARGO_EXECUTABLE}" build --release --lib --quiet
+          "${CARGO_EXECUTABLE}" build --release --lib --bin curvetet --quiet
           --manifest-path "${PROJECT_SOURCE_DIR}/Cargo.toml"
   COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${_cargo_out}/libcurvetet.a" "${CURVETET_STATIC_LIBRARY}"
   COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${_cargo_out}/libcurvetet.so" "${CURVETET_SHARED_LIBRARY}"
   COMMAND "${CMAKE_COMMAND}" -E create_symlink "${CURVETET_SONAME}" "${CURVETET_SHARED_LINK}"
+  COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${_cargo_out}/curvetet" "${CURVETET_EXECUTABLE}"
   BYPRODUCTS "${CURVETET_STATIC_LIBRARY}" "${CURVETET_SHARED_LIBRARY}" "${CURVETET_SHARED_LINK}"
+             "${CURVETET_EXECUTABLE}"
   WORKING_DIRECTORY "${PROJECT_SOURCE_DIR}"
-  COMMENT "cargo build --release --lib (curvetet)"
+  COMMENT "cargo build --release --lib --bin curvetet (curvetet)"
   USES_TERMINAL
   VERBATIM)
 

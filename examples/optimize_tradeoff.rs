@@ -11,7 +11,7 @@
 //! least `--floor` (default 0.62, the test suite's screw floor) and max skewness at most
 //! `--max-skew` (default 0.68, the test suite's screw ceiling); and the Pareto front of
 //! ratio against certified min: the evidence behind the high-order stage's default
-//! tuning and the README's figures.
+//! tuning and the figures in docs/benchmarks.md.
 
 use curvetet::front::run_front;
 use curvetet::generate::size_field;
@@ -99,7 +99,7 @@ fn median(v: &mut [f64]) -> f64 {
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let mut path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/screw_p2.msh");
+    let mut path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/screw_p2.msh");
     let (mut runs, mut floor, mut max_skew) = (5usize, 0.62f64, 0.68f64);
     let mut i = 0;
     while i < args.len() {
@@ -124,8 +124,9 @@ fn main() {
         }
     };
     let opts = Options::default();
-    // As `generate` runs it: the high-order stage inside the pool (all cores).
-    let pool = match curvetet::threads::pool(opts.threads) {
+    // As `curvetet mesh` runs it: the high-order stage inside the pool (all cores, each
+    // worker on its own CPU).
+    let pool = match curvetet::threads::pool(opts.threads, true) {
         Ok(p) => p,
         Err(e) => {
             eprintln!("{e}");

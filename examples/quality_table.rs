@@ -1,8 +1,9 @@
-//! Benchmark (not a test): the issue's quality table with curvetet's column filled in.
+//! Benchmark (not a test): curvetet's quality on the paper's surfaces beside the paper's
+//! and Gmsh's (docs/benchmarks.md, "Quality against the paper and Gmsh").
 //!
 //! `cargo run --release --example quality_table [DATA_DIR] [SURFACE...]`
 //!
-//! For every benchmark surface (../shared/data beside the repository by default) it
+//! For every benchmark surface (tests/data by default) it
 //! meshes with the default options and prints the certified min of min J / max J next to
 //! the paper's and Gmsh's, the max equiangular skewness, the counts above 0.85 and 0.9,
 //! the dihedral angle range and the time of each stage; the raw front mesh (optimization
@@ -11,8 +12,9 @@
 use curvetet::{generate, io, Options};
 use std::path::PathBuf;
 
-/// (surface, paper, Gmsh P2, Gmsh optimized with the boundary fixed, target) from the
-/// issue; `None` where the paper has no value.
+/// (surface, paper, Gmsh P2, Gmsh optimized with the boundary fixed, target): the paper's
+/// values, Gmsh's on the same geometry, and the project's targets; `None` where the paper
+/// has no value.
 const ROWS: [(&str, Option<f64>, f64, f64, f64); 6] = [
     ("sphere", None, 0.762, 0.762, 0.80),
     ("torus", Some(0.681), 0.544, 0.544, 0.75),
@@ -27,7 +29,7 @@ fn main() {
     let (dir, names): (PathBuf, Vec<String>) = match args.first() {
         Some(d) if std::path::Path::new(d).is_dir() => (d.into(), args[1..].to_vec()),
         _ => (
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data"),
             args.clone(),
         ),
     };
@@ -49,14 +51,19 @@ fn main() {
                 continue;
             }
         };
+        // Timed as `curvetet mesh` runs: each worker on its own CPU.
+        let opts = Options {
+            pin_threads: true,
+            ..Options::default()
+        };
         let raw = generate(
             &surface,
             &Options {
                 optimize: false,
-                ..Options::default()
+                ..opts.clone()
             },
         );
-        let g = match generate(&surface, &Options::default()) {
+        let g = match generate(&surface, &opts) {
             Ok(g) => g,
             Err(e) => {
                 let msg = e.to_string();

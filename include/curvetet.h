@@ -24,6 +24,14 @@
  *   as CURVETET_ERR_PANIC. Callbacks must not unwind (throw) through curvetet either.
  * - Versioned structs (curvetet_options, curvetet_quality) start with struct_size; set
  *   it to sizeof(the struct) (curvetet_options_default does) so the struct can grow.
+ * - Threads: curvetet_generate runs the front (and every progress callback) on the
+ *   calling thread, and its parallel stages on a pool of curvetet_options.threads
+ *   workers (0: one per CPU) that it creates and joins before returning; results do
+ *   not depend on the count. Worker threads are not pinned to CPUs unless
+ *   curvetet_options.pin_threads asks (then only a pool of one worker per CPU is
+ *   pinned); the environment variable CURVETET_PIN_THREADS overrides that: 0 never
+ *   pins, 1 pins as if asked. (CURVETET_DIAGNOSE=1 prints why a failed front was
+ *   stuck to stderr; no other environment variable is read.)
  */
 
 #ifndef CURVETET_H
@@ -39,6 +47,8 @@
 #define CURVETET_VERSION_MINOR 1
 #define CURVETET_VERSION_PATCH 0
 #define CURVETET_VERSION "0.1.0"
+/** MAJOR * 10000 + MINOR * 100 + PATCH (0.1.0: 100); curvetet_version_number(). */
+#define CURVETET_VERSION_NUMBER 100
 /** The shared library's ABI version (its SONAME is libcurvetet.so.<this>). */
 #define CURVETET_ABI_VERSION "0.1"
 
@@ -102,7 +112,7 @@ typedef enum curvetet_status {
      * An internal error (a Rust panic) was caught at the ABI boundary; the message holds
      * the panic message. Please report it.
      */
-    CURVETET_ERR_PANIC = 8,
+    CURVETET_ERR_PANIC = 8
 } curvetet_status;
 
 /**
@@ -119,7 +129,7 @@ typedef enum curvetet_node_order {
      * VTK cell type 24 (VTK_QUADRATIC_TETRA): then edges (0,3), (1,3), (2,3), i.e. Gmsh's
      * order with the last two nodes swapped.
      */
-    CURVETET_ORDER_VTK = 1,
+    CURVETET_ORDER_VTK = 1
 } curvetet_node_order;
 
 /**
@@ -170,8 +180,9 @@ typedef struct curvetet_options {
      */
     int32_t optimize;
     /**
-     * Worker threads for the parallel stages; 0 (default): all cores. The result does
-     * not depend on it.
+     * Worker threads for the parallel stages; 0 (default): one per CPU. The pool is
+     * created by each `curvetet_generate` call and gone when it returns; the front and
+     * the progress callback run on the calling thread. The result does not depend on it.
      */
     uint32_t threads;
     /**
@@ -191,12 +202,20 @@ typedef struct curvetet_options {
     /**
      * Nonzero: more high-order rounds where some element starts poor (CAD parts), for
      * fewer elements left between the worst one and min J / max J 0.85, at two to three
-     * times that stage's work there. Default 0. (Added after `uniform_size`, in what
-     * was its padding: `struct_size` did not grow, so older callers get the default
-     * through `curvetet_options_default` or `curvetet_options_init`, as every caller
-     * must initialise.)
+     * times that stage's work there. Default 0. Read only when `struct_size` is at least
+     * the third version's size (this header's `sizeof`): the bytes of an older,
+     * smaller struct here were its padding.
      */
     int32_t thorough;
+    /**
+     * Nonzero: keep each worker thread on its own CPU when there is one worker per CPU
+     * the process may use (`threads` = 0 or that count). Default 0: threads are left to
+     * the operating system, as a host application expects of a library; pinning helps a
+     * process that does nothing else (the `curvetet` command pins). The environment
+     * variable `CURVETET_PIN_THREADS` overrides this either way (`0`: never, `1`: as if
+     * set). The result does not depend on it.
+     */
+    int32_t pin_threads;
 } curvetet_options;
 
 /**
@@ -243,13 +262,21 @@ typedef struct curvetet_quality {
 
 #ifdef __cplusplus
 extern "C" {
-#endif // __cplusplus
+#endif /* __cplusplus */
 
 /**
  * The library version, e.g. "0.1.0" (the same as the `CURVETET_VERSION` macro of the
  * header it was built with). A static string: never free it.
  */
 const char *curvetet_version(void);
+
+/**
+ * The library version as one number, MAJOR * 10000 + MINOR * 100 + PATCH (0.1.0 is
+ * 100; the same as the `CURVETET_VERSION_NUMBER` macro of the header it was built
+ * with), for comparing at run time: `curvetet_version_number() >= 10200` is 1.2.0 or
+ * later.
+ */
+uint32_t curvetet_version_number(void);
 
 /**
  * The message of the last failed curvetet call on this thread, "" when the last
@@ -634,8 +661,8 @@ size_t curvetet_surface_num_warnings(const struct curvetet_surface *s);
 const char *curvetet_surface_warning(const struct curvetet_surface *s, size_t i);
 
 #ifdef __cplusplus
-}  // extern "C"
-#endif  // __cplusplus
+}  /* extern "C" */
+#endif  /* __cplusplus */
 
 #endif  /* CURVETET_H */
 

@@ -4,6 +4,7 @@
 use crate::front::size::{corner_sizes, regular_edge_from_area, SizeField};
 use crate::front::{run_front, FrontStats, RESTARTS};
 use crate::geom::quadrature::tri6_area;
+#[cfg(feature = "fault-injection")]
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
 use crate::mesh::quality::{uncertified, QualityReport};
@@ -118,7 +119,7 @@ pub fn generate_with_progress(
     progress: &mut dyn FnMut(f64, &str) -> bool,
 ) -> Result<Generated> {
     opts.validate()?;
-    let pool = crate::threads::pool(opts.threads)?;
+    let pool = crate::threads::pool(opts.threads, opts.pin_threads)?;
     generate_inner(surface, opts, progress, &pool)
 }
 
@@ -191,7 +192,8 @@ fn generate_inner(
             ostats.time_high_order = t.elapsed().as_secs_f64();
         }
         times.optimize += ostats.time_linear + ostats.time_high_order;
-        // Tests only (see INJECT_FAULT_ENV): corrupt the mesh just before the final check.
+        // Tests only (feature `fault-injection`, see INJECT_FAULT_ENV): corrupt the mesh
+        // just before the final check.
         let mesh = inject_fault(mesh, surface.nodes().len(), first == 0);
 
         if progress(1.0, "certify") {
@@ -309,9 +311,18 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
 /// (default 0; conformity fails), `jacobian[:T]` moves an interior mid node of tet `T` next
 /// to a corner (the mesh stays conforming but tet `T` is not certified valid), and
 /// `jacobian-once[:T]` does so on the first attempt only (the restart must then deliver a
-/// certified mesh). Tests only.
+/// certified mesh). Read only in a build with the cargo feature `fault-injection` (the
+/// test `invalid_mesh` requires it): a library in use never looks at it.
 pub const INJECT_FAULT_ENV: &str = "CURVETET_INJECT_INVALID_MESH";
 
+/// Without the `fault-injection` feature: the mesh unchanged.
+#[cfg(not(feature = "fault-injection"))]
+fn inject_fault(mesh: TetMesh, _surface_nodes: usize, _first_attempt: bool) -> TetMesh {
+    mesh
+}
+
+/// The fault [`INJECT_FAULT_ENV`] asks for, if any.
+#[cfg(feature = "fault-injection")]
 fn inject_fault(mut mesh: TetMesh, surface_nodes: usize, first_attempt: bool) -> TetMesh {
     let Ok(spec) = std::env::var(INJECT_FAULT_ENV) else {
         return mesh;

@@ -55,6 +55,12 @@ pub struct Options {
     pub thorough: bool,
     /// Worker threads for parallel stages; 0 = all cores. Results never depend on it.
     pub threads: usize,
+    /// Keep each worker of a pool with one worker per CPU on its own CPU (see
+    /// [`crate::threads`]). Off by default: a host application (VTK, ParaView, Gmsh,
+    /// MeshLab) places its own threads, and a library must not pin them behind its back.
+    /// The `curvetet` command turns it on; `CURVETET_PIN_THREADS` (`1` or `0`) overrides
+    /// it either way. Results never depend on it.
+    pub pin_threads: bool,
     /// Minimum dihedral angle of a candidate, degrees (paper: 15).
     pub min_dihedral_deg: f64,
     /// Maximum equiangular skewness of a candidate unless nothing better exists (paper: 0.9).
@@ -74,6 +80,7 @@ impl Default for Options {
             optimize: true,
             thorough: false,
             threads: 0,
+            pin_threads: false,
             min_dihedral_deg: 15.0,
             max_skewness: 0.9,
             min_edge_face_angle_deg: 10.0,

@@ -1,30 +1,32 @@
-//! The worker pool of the parallel stages, with each worker kept on its own CPU.
+//! The worker pool of the parallel stages, with each worker optionally kept on its own
+//! CPU.
 //!
 //! Why pin: the pool's workers sleep through the front (which runs on the calling
 //! thread) and between the optimizer's batches, and Linux wakes a sleeping thread on the
-//! waker's CPU. On the 2-vCPU machines here both workers then shared one CPU in 4 ms time
-//! slices until the load balancer moved one: single patches of the high-order stage took
-//! 2-5 ms instead of 0.2 ms, and two threads were no faster than one. With worker i on
-//! the i-th CPU the process may use, the high-order stage takes 30-35% less time on the
-//! torus, tube, lv and hinge (medians of 7 runs).
+//! waker's CPU. On a machine with few CPUs two workers then share one CPU in
+//! scheduler time slices until the load balancer moves one, and two threads are no
+//! faster than one; with worker i on the i-th CPU the process may use, the high-order
+//! stage takes about a third less time (docs/benchmarks.md).
 //!
-//! Only a pool with exactly one worker per CPU the process may use is pinned (the
-//! default, `threads` = 0): a smaller pool is left free, so that concurrent calls with
-//! a few threads each do not all crowd onto the first CPUs. `CURVETET_PIN_THREADS=0`
-//! turns pinning off (for a host application that places its threads itself). The
-//! result never depends on it.
+//! Why not by default: a library inside a host process (VTK, ParaView, MeshLab, Gmsh)
+//! must not place threads the host may be placing itself. So pinning is asked for
+//! ([`crate::Options::pin_threads`]; the `curvetet` command asks), and even then only a
+//! pool with exactly one worker per CPU the process may use is pinned: a smaller pool is
+//! left free, so that concurrent calls with a few threads each do not all crowd onto the
+//! first CPUs. `CURVETET_PIN_THREADS` overrides the request: `0`/`false`/`no`/`off` never
+//! pins, `1`/`true`/`yes`/`on` pins as if asked. The result never depends on it.
 
 use crate::{Error, Result};
 
 /// A rayon pool of `threads` workers (0: as many as rayon chooses, one per CPU by
-/// default), pinned as the module docs say.
-pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+/// default), pinned as the module docs say when `pin` (or `CURVETET_PIN_THREADS`) asks.
+pub fn pool(threads: usize, pin: bool) -> Result<rayon::ThreadPool> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| Error::InvalidArgument(format!("cannot start {threads} threads: {e}")))?;
     let n = pool.current_num_threads();
-    if n > 1 && pinning_wanted() {
+    if n > 1 && pinning_wanted(pin) {
         let cpus = allowed_cpus();
         if n == cpus.len() {
             // Every worker runs this once, with its own index.
@@ -34,11 +36,16 @@ pub fn pool(threads: usize) -> Result<rayon::ThreadPool> {
     Ok(pool)
 }
 
-/// False when `CURVETET_PIN_THREADS` is `0`, `false`, `no` or `off`.
-fn pinning_wanted() -> bool {
-    match std::env::var("CURVETET_PIN_THREADS") {
-        Ok(v) => !matches!(v.trim(), "0" | "false" | "no" | "off"),
-        Err(_) => true,
+/// The environment variable that overrides [`crate::Options::pin_threads`].
+pub const PIN_THREADS_ENV: &str = "CURVETET_PIN_THREADS";
+
+/// `asked`, unless `CURVETET_PIN_THREADS` says otherwise (`0`, `false`, `no`, `off`: no;
+/// `1`, `true`, `yes`, `on`: yes; anything else leaves `asked`).
+fn pinning_wanted(asked: bool) -> bool {
+    match std::env::var(PIN_THREADS_ENV).as_deref().map(str::trim) {
+        Ok("0" | "false" | "no" | "off") => false,
+        Ok("1" | "true" | "yes" | "on") => true,
+        _ => asked,
     }
 }
 
@@ -88,19 +95,23 @@ mod tests {
 
     #[cfg(target_os = "linux")]
     #[test]
-    fn a_pool_of_one_worker_per_cpu_is_pinned_a_smaller_one_is_not() {
+    fn a_pool_of_one_worker_per_cpu_is_pinned_when_asked_a_smaller_one_is_not() {
         let cpus = allowed_cpus();
         assert!(!cpus.is_empty());
-        if cpus.len() < 2 || !pinning_wanted() {
-            return; // nothing to pin on this machine, or pinning turned off
+        if cpus.len() < 2 || std::env::var_os(PIN_THREADS_ENV).is_some() {
+            return; // nothing to pin on this machine, or the environment decides
         }
-        let on = worker_cpus(&pool(cpus.len()).unwrap());
+        // Not asked (the library's default): every worker may run on every CPU.
+        let free = worker_cpus(&pool(cpus.len(), false).unwrap());
+        assert_eq!(free.len(), cpus.len());
+        assert!(free.iter().all(|w| w == &cpus), "{free:?}");
+        let on = worker_cpus(&pool(cpus.len(), true).unwrap());
         assert_eq!(on.len(), cpus.len());
         for (i, w) in on.iter().enumerate() {
             assert_eq!(w, &vec![cpus[i]], "worker {i}");
         }
         if cpus.len() > 2 {
-            let on = worker_cpus(&pool(cpus.len() - 1).unwrap());
+            let on = worker_cpus(&pool(cpus.len() - 1, true).unwrap());
             assert!(on.iter().all(|w| w == &cpus), "{on:?}");
         }
     }

@@ -43,6 +43,9 @@ fn header_declares_the_contract() {
         "typedef struct curvetet_mesh curvetet_mesh;",
         "typedef int (*curvetet_progress_fn)(void *user_data, double fraction, const char *stage);",
         "const char *curvetet_version(void);",
+        "uint32_t curvetet_version_number(void);",
+        "#define CURVETET_VERSION_NUMBER ",
+        "CURVETET_PIN_THREADS",
         "const char *curvetet_last_error_message(void);",
         "void curvetet_options_default(struct curvetet_options *out);",
         "enum curvetet_status curvetet_surface_read(const char *path, struct curvetet_surface **out);",
@@ -54,8 +57,8 @@ fn header_declares_the_contract() {
         "enum curvetet_status curvetet_mesh_write(const struct curvetet_mesh *m, const char *path);",
         "void curvetet_mesh_free(struct curvetet_mesh *m);",
         "curvetet_node_order order,",
-        "CURVETET_ERR_PANIC = 8,",
-        "CURVETET_ORDER_VTK = 1,",
+        "CURVETET_ERR_PANIC = 8\n} curvetet_status;",
+        "CURVETET_ORDER_VTK = 1\n} curvetet_node_order;",
     ] {
         assert!(h.contains(needle), "include/curvetet.h lacks {needle:?}");
     }
@@ -68,9 +71,56 @@ fn header_declares_the_contract() {
             || line.starts_with("void ")
             || line.starts_with("size_t ")
             || line.starts_with("double ")
+            || line.starts_with("uint32_t ")
         {
             assert_eq!(prev.trim(), "*/", "undocumented: {line}");
         }
         prev = line;
     }
+}
+
+/// The header is plain C89 (no comma after an enum's last value, no `//` comments, no
+/// declarations a pedantic C89 compiler warns about) and clean C++ too: compiled with
+/// the system's `cc` and `c++` as warnings-are-errors.
+#[test]
+fn header_compiles_as_pedantic_c89_and_cxx() {
+    let dir = std::env::temp_dir().join(format!("curvetet_c89_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let include = Path::new(env!("CARGO_MANIFEST_DIR")).join("include");
+    let src = "#include <curvetet.h>\n\
+               int main(void) {\n\
+               \x20   curvetet_options o;\n\
+               \x20   curvetet_options_default(&o);\n\
+               \x20   return curvetet_version_number() == CURVETET_VERSION_NUMBER ? 0 : (int)o.threads;\n\
+               }\n";
+    for (compiler, file, flags) in [
+        (
+            "cc",
+            "t.c",
+            &["-std=c89", "-pedantic", "-Wall", "-Wextra", "-Werror"][..],
+        ),
+        (
+            "c++",
+            "t.cpp",
+            &["-std=c++11", "-pedantic", "-Wall", "-Wextra", "-Werror"][..],
+        ),
+    ] {
+        let path = dir.join(file);
+        std::fs::write(&path, src).unwrap();
+        let out = std::process::Command::new(compiler)
+            .args(flags)
+            .arg("-fsyntax-only")
+            .arg("-I")
+            .arg(&include)
+            .arg(&path)
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run {compiler}: {e}"));
+        assert!(
+            out.status.success(),
+            "{compiler} {} rejects include/curvetet.h:\n{}",
+            flags.join(" "),
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -53,6 +53,7 @@ class _Options(ctypes.Structure):
         ("user_data", ctypes.c_void_p),
         ("uniform_size", ctypes.c_int32),
         ("thorough", ctypes.c_int32),
+        ("pin_threads", ctypes.c_int32),
     ]
 
 

@@ -254,6 +254,9 @@ impl MeshOptions {
             optimize: !self.no_optimize,
             thorough: self.thorough,
             threads: self.threads,
+            // The command owns its process: keep each worker on its own CPU (see
+            // curvetet::threads; CURVETET_PIN_THREADS=0 turns it off).
+            pin_threads: true,
             ..Options::default()
         }
     }
@@ -474,7 +477,7 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     }
     // The surface checks (parallel) run on as many threads as the meshing: `--threads 1`
     // is one thread from start to end.
-    let surface = curvetet::threads::pool(a.mesh.threads)?
+    let surface = curvetet::threads::pool(a.mesh.threads, true)?
         .install(|| read_surface_any(&a.input, &a.curve))?;
     if let Some(budget) = a.max_memory {
         let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());

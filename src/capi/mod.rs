@@ -34,7 +34,9 @@ pub use mesh::{
     curvetet_mesh_write_with_flags, curvetet_node_order, curvetet_quality, NodeOrderArg,
     CURVETET_WRITE_BINARY, CURVETET_WRITE_MEDIT_LINEAR, CURVETET_WRITE_MSH22, QUALITY_SIZE_V1,
 };
-pub use options::{curvetet_options, curvetet_progress_fn, OPTIONS_SIZE_V1};
+pub use options::{
+    curvetet_options, curvetet_progress_fn, OPTIONS_SIZE_V1, OPTIONS_SIZE_V2, OPTIONS_SIZE_V3,
+};
 pub use status::{curvetet_status, StatusArg};
 pub use surface::{
     curvetet_surface, curvetet_surface_free, curvetet_surface_from_arrays, curvetet_surface_nodes,
@@ -60,6 +62,35 @@ pub extern "C" fn curvetet_version() -> *const c_char {
         Ok(concat!(env!("CARGO_PKG_VERSION"), "\0").as_ptr().cast())
     })
 }
+
+/// The library version as one number, MAJOR * 10000 + MINOR * 100 + PATCH (0.1.0 is
+/// 100; the same as the `CURVETET_VERSION_NUMBER` macro of the header it was built
+/// with), for comparing at run time: `curvetet_version_number() >= 10200` is 1.2.0 or
+/// later.
+#[no_mangle]
+pub extern "C" fn curvetet_version_number() -> u32 {
+    value_call("curvetet_version_number", 0, || Ok(VERSION_NUMBER))
+}
+
+/// MAJOR * 10000 + MINOR * 100 + PATCH of this crate.
+const VERSION_NUMBER: u32 = {
+    /// A decimal string's value (the version parts cargo sets).
+    const fn number(s: &str) -> u32 {
+        let b = s.as_bytes();
+        let mut n = 0;
+        let mut i = 0;
+        while i < b.len() {
+            assert!(b[i].is_ascii_digit());
+            n = n * 10 + (b[i] - b'0') as u32;
+            i += 1;
+        }
+        n
+    }
+    let minor = number(env!("CARGO_PKG_VERSION_MINOR"));
+    let patch = number(env!("CARGO_PKG_VERSION_PATCH"));
+    assert!(minor < 100 && patch < 100);
+    number(env!("CARGO_PKG_VERSION_MAJOR")) * 10000 + minor * 100 + patch
+};
 
 /// The message of the last failed curvetet call on this thread, "" when the last
 /// status-returning call succeeded (or none was made). Never NULL. The string is owned by

@@ -1,8 +1,12 @@
 //! `curvetet_options`: the versioned options struct, and its conversion to [`Options`].
 //!
 //! Versioning: the caller puts `sizeof(curvetet_options)` of the header it was compiled
-//! with in `struct_size`. A library reads only the fields that fit in `struct_size`
-//! (fields a smaller, older struct lacks take their defaults) and refuses:
+//! with in `struct_size`. Each field belongs to the version that added it, and a library
+//! reads a field only when `struct_size` is at least that version's whole `sizeof`
+//! ([`OPTIONS_SIZE_V1`], [`OPTIONS_SIZE_V2`], [`OPTIONS_SIZE_V3`]); the fields of a
+//! newer version take their defaults. Whole sizes, not field ends: a field added in an
+//! older version's tail padding (`thorough`, in the padding after `uniform_size`) would
+//! otherwise be read from the garbage an older caller left there. The library refuses:
 //! - a `struct_size` smaller than the first version's ([`OPTIONS_SIZE_V1`]): it was never
 //!   set (0) or is garbage;
 //! - a `struct_size` above [`MAX_STRUCT_SIZE`] (garbage);
@@ -12,7 +16,7 @@
 use super::guard::{check_ptr, invalid};
 use crate::{Options, Result, SizeMode};
 use std::ffi::{c_char, c_int, c_void};
-use std::mem::{offset_of, size_of};
+use std::mem::{align_of, offset_of, size_of};
 
 /// Progress callback: called from the thread that called `curvetet_generate`, with the
 /// fraction of the work done (0..1, non-decreasing within a stage) and a short stage
@@ -42,8 +46,9 @@ pub struct curvetet_options {
     pub size: f64,
     /// Nonzero (default 1): quality improvement and high-order optimization.
     pub optimize: i32,
-    /// Worker threads for the parallel stages; 0 (default): all cores. The result does
-    /// not depend on it.
+    /// Worker threads for the parallel stages; 0 (default): one per CPU. The pool is
+    /// created by each `curvetet_generate` call and gone when it returns; the front and
+    /// the progress callback run on the calling thread. The result does not depend on it.
     pub threads: u32,
     /// Progress callback; may be NULL (default).
     pub progress: curvetet_progress_fn,
@@ -55,17 +60,42 @@ pub struct curvetet_options {
     pub uniform_size: i32,
     /// Nonzero: more high-order rounds where some element starts poor (CAD parts), for
     /// fewer elements left between the worst one and min J / max J 0.85, at two to three
-    /// times that stage's work there. Default 0. (Added after `uniform_size`, in what
-    /// was its padding: `struct_size` did not grow, so older callers get the default
-    /// through `curvetet_options_default` or `curvetet_options_init`, as every caller
-    /// must initialise.)
+    /// times that stage's work there. Default 0. Read only when `struct_size` is at least
+    /// the third version's size (this header's `sizeof`): the bytes of an older,
+    /// smaller struct here were its padding.
     pub thorough: i32,
+    /// Nonzero: keep each worker thread on its own CPU when there is one worker per CPU
+    /// the process may use (`threads` = 0 or that count). Default 0: threads are left to
+    /// the operating system, as a host application expects of a library; pinning helps a
+    /// process that does nothing else (the `curvetet` command pins). The environment
+    /// variable `CURVETET_PIN_THREADS` overrides this either way (`0`: never, `1`: as if
+    /// set). The result does not depend on it.
+    pub pin_threads: i32,
 }
 
 /// `sizeof(curvetet_options)` of the first version of the ABI (curvetet 0.1): every
 /// accepted struct has at least these fields.
 pub const OPTIONS_SIZE_V1: usize =
     offset_of!(curvetet_options, user_data) + size_of::<*mut c_void>();
+
+/// `sizeof(curvetet_options)` of the second version: `uniform_size` added, then tail
+/// padding (where `thorough` was later declared: not read at this size). 56 on 64-bit
+/// platforms.
+pub const OPTIONS_SIZE_V2: usize = (offset_of!(curvetet_options, uniform_size) + size_of::<i32>())
+    .next_multiple_of(align_of::<curvetet_options>());
+
+/// `sizeof(curvetet_options)` of the third version: `thorough` and `pin_threads` added
+/// (64 on 64-bit platforms).
+pub const OPTIONS_SIZE_V3: usize = (offset_of!(curvetet_options, pin_threads) + size_of::<i32>())
+    .next_multiple_of(align_of::<curvetet_options>());
+
+// Each version is larger than the one before, and the third is this struct: a fourth
+// version adds its fields after `pin_threads` and its own size constant.
+const _: () = {
+    assert!(OPTIONS_SIZE_V1 < OPTIONS_SIZE_V2 && OPTIONS_SIZE_V2 < OPTIONS_SIZE_V3);
+    assert!(OPTIONS_SIZE_V3 == size_of::<curvetet_options>());
+    assert!(offset_of!(curvetet_options, thorough) < OPTIONS_SIZE_V2);
+};
 
 /// Largest `struct_size` accepted for a versioned struct: bigger is garbage.
 pub(crate) const MAX_STRUCT_SIZE: usize = 4096;
@@ -84,6 +114,7 @@ impl curvetet_options {
             user_data: std::ptr::null_mut(),
             uniform_size: 0,
             thorough: d.thorough as i32,
+            pin_threads: d.pin_threads as i32,
         }
     }
 }
@@ -139,29 +170,33 @@ pub(crate) unsafe fn parse(p: *const curvetet_options) -> Result<Parsed> {
                 )));
             }
         }
-        // Copy field `$f` when the caller's struct is big enough to hold it.
+        // Copy field `$f` when the caller's struct is at least the version `$v` that
+        // added it (the module docs say why whole versions, not field ends).
         macro_rules! take {
-            ($f:ident) => {
-                if offset_of!(curvetet_options, $f) + size_of_val(&o.$f) <= size {
+            ($f:ident, $v:expr) => {
+                if size >= $v {
+                    debug_assert!(offset_of!(curvetet_options, $f) + size_of_val(&o.$f) <= $v);
                     // SAFETY: the field lies within the caller's `size` bytes.
                     o.$f = unsafe { std::ptr::addr_of!((*p).$f).read() };
                 }
             };
         }
-        take!(alpha);
-        take!(size);
-        take!(optimize);
-        take!(threads);
-        take!(progress);
-        take!(user_data);
-        take!(uniform_size);
-        take!(thorough);
+        take!(alpha, OPTIONS_SIZE_V1);
+        take!(size, OPTIONS_SIZE_V1);
+        take!(optimize, OPTIONS_SIZE_V1);
+        take!(threads, OPTIONS_SIZE_V1);
+        take!(progress, OPTIONS_SIZE_V1);
+        take!(user_data, OPTIONS_SIZE_V1);
+        take!(uniform_size, OPTIONS_SIZE_V2);
+        take!(thorough, OPTIONS_SIZE_V3);
+        take!(pin_threads, OPTIONS_SIZE_V3);
     }
     let mut options = Options {
         alpha: o.alpha,
         optimize: o.optimize != 0,
         thorough: o.thorough != 0,
         threads: o.threads as usize,
+        pin_threads: o.pin_threads != 0,
         ..Options::default()
     };
     options.size = if o.size.is_nan() || o.size > 0.0 {

@@ -93,6 +93,15 @@ fn every_error_maps_to_its_stable_code() {
 fn version_is_the_crate_version() {
     let v = unsafe { CStr::from_ptr(curvetet_version()) };
     assert_eq!(v.to_str().unwrap(), env!("CARGO_PKG_VERSION"));
+    // The number is the same version: "0.1.0" -> 100.
+    let parts: Vec<u32> = env!("CARGO_PKG_VERSION")
+        .split('.')
+        .map(|p| p.parse().unwrap())
+        .collect();
+    assert_eq!(
+        curvetet_version_number(),
+        parts[0] * 10000 + parts[1] * 100 + parts[2]
+    );
 }
 
 #[test]
@@ -138,6 +147,30 @@ fn options_struct_size_is_checked() {
     assert_eq!(p1.size, SizeMode::Graded);
     assert!(!p1.thorough);
     assert!(unsafe { parse(null()) }.is_ok());
+
+    // A second-version struct (uniform_size, then 4 bytes of tail padding where this
+    // header has `thorough`) from an old caller: garbage in that padding must not turn
+    // `thorough` on, while `uniform_size` is read.
+    assert!(std::mem::offset_of!(curvetet_options, thorough) < OPTIONS_SIZE_V2);
+    let mut v2 = o;
+    v2.struct_size = OPTIONS_SIZE_V2 as u32;
+    v2.uniform_size = 1;
+    v2.thorough = 0x5a5a_5a5a; // what an old caller's stack left in its padding
+    v2.pin_threads = 1; // past the old struct's end
+    let p2 = unsafe { parse(&v2) }.unwrap().options;
+    assert_eq!(p2.size, SizeMode::Uniform);
+    assert!(
+        !p2.thorough,
+        "an old struct's padding was read as `thorough`"
+    );
+    assert!(!p2.pin_threads);
+    // The same bytes with this version's size: both are read.
+    v2.struct_size = OPTIONS_SIZE_V3 as u32;
+    let p3 = unsafe { parse(&v2) }.unwrap().options;
+    assert!(p3.thorough && p3.pin_threads);
+    // pin_threads is off by default (a host application places its own threads).
+    assert_eq!(o.pin_threads, 0);
+    assert!(!p.options.pin_threads);
 
     for bad in [
         0u32,
