@@ -17,7 +17,7 @@
 //!   one thread), setOrder(2), write .msh; its time is measured inside the script (merge to
 //!   write, Python start-up excluded), its memory includes the Python interpreter.
 //!
-//! Inputs: every tests/data/NAME_p2.msh (the ../shared/data surfaces), the raw
+//! Inputs: every tests/data/NAME_p2.msh (the paper's benchmark surfaces), the raw
 //! marching-cubes blob tests/data/mc_blob.off smoothed and curved (`curve --smooth 10`:
 //! an image-derived surface), and the built-in
 //! torus (`curvetet demo --surface-only`) sized for ≈10k/100k/1M curvetet tets.
@@ -193,7 +193,7 @@ fn measure(runs: usize, mut once: impl FnMut() -> Result<(f64, u64, usize), Stri
 }
 
 /// The first Python that imports `gmsh`, with the module's version: $CURVETET_BENCH_PYTHON,
-/// then the PyPI gmsh venv scripts/install-deps makes (Gmsh 4.15, the reference
+/// then the PyPI gmsh venv scripts/install-deps makes (Gmsh 4.15, the reference
 /// version), then the system's python3-gmsh (4.8).
 fn python_with_gmsh() -> Option<(String, String)> {
     let mut c: Vec<String> = Vec::new();

@@ -5,7 +5,7 @@
 # (--no-shift: rings not shifted, each quad split into two right triangles)
 # Few NU for many NV gives anisotropic triangles: 50 x 54 (aspect ratio 2.0 median) took
 # the front's fourth configuration and a minute with edge sizes, 2.4 s with the area sizes
-# `--size-from auto` picks for it (README); 20-25 x 54 still leave the front stuck.
+# `--size-from auto` picks for it (docs/cli.md); 20-25 x 54 still leave the front stuck.
 import math, sys
 nu, nv, out = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3]
 shift = "--no-shift" not in sys.argv[4:]

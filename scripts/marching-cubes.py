@@ -3,7 +3,7 @@
 # segmentation pipeline gives them (needle and cap triangles):
 #     scripts/marching-cubes.py N SHAPE out.off   (N grid points per axis; needs
 #     scikit-image). tests/data/mc_blob.off is `22 blob`. Mesh them with --smooth 10
-#     (README, "Surfaces from image segmentation").
+#     (docs/cli.md and docs/benchmarks.md, "Surfaces from image segmentation").
 import sys, numpy as np
 from skimage import measure
 n, shape, out = int(sys.argv[1]), sys.argv[2], sys.argv[3]

@@ -23,3 +23,8 @@ pub use generate::{generate, generate_with_progress, Generated};
 pub use mesh::TetMesh;
 pub use options::{Options, SizeFrom, SizeMode};
 pub use surface::Surface;
+
+/// README.md's Rust example, compiled and run as a doctest so that it cannot go stale.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

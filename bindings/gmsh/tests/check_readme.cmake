@@ -1,4 +1,4 @@
-# ctest gmsh_readme: README.md shows each example file verbatim in a fenced block, so the
+# ctest gmsh_readme: docs/gmsh.md (README) shows each example file verbatim in a fenced block, so the
 # documented examples are the ones the tests compile and run.
 #   cmake -DREADME=... "-DEXAMPLES=file|lang;file|lang" -P check_readme.cmake
 file(READ "${README}" readme)
@@ -9,6 +9,6 @@ foreach(e IN LISTS EXAMPLES)
   file(READ "${path}" example)
   string(FIND "${readme}" "```${lang}\n${example}```" pos)
   if(pos EQUAL -1)
-    message(FATAL_ERROR "README.md's ${lang} example differs from ${path}; paste the file into a ```${lang} block")
+    message(FATAL_ERROR "${README}'s ${lang} example differs from ${path}; paste the file into a ```${lang} block")
   endif()
 endforeach()

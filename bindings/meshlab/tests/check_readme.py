@@ -1,12 +1,12 @@
-"""The README's MeshLab section says how to build, install and use the plugin as it is built.
+"""The MeshLab page (docs/meshlab.md) says how to build, install and use the plugin as it is
+built.
 
-check_readme.py README.md
+check_readme.py docs/meshlab.md
 """
 import sys
 
-text = open(sys.argv[1]).read()
-assert "\n## MeshLab\n" in text, "README: no '## MeshLab' section"
-section = text.split("\n## MeshLab\n", 1)[1].split("\n## ", 1)[0]
+section = open(sys.argv[1]).read()
+assert section.startswith("# MeshLab"), f"{sys.argv[1]}: not the MeshLab page"
 for needle in [
     "Tetrahedralize: curved quadratic (curvetet)",  # the filter's name, as in the menu
     "Filters",  # where it is in the GUI
@@ -21,5 +21,5 @@ for needle in [
     "bindings/meshlab/LICENSE.md",
     "alpha", "featureAngle", "smoothIterations", "optimize", "thorough", "outputFile",
 ]:
-    assert needle in section, f"README's MeshLab section lacks {needle!r}"
-print("README: the MeshLab section names the filter, the build, the install and the GUI steps")
+    assert needle in section, f"{sys.argv[1]} lacks {needle!r}"
+print(f"{sys.argv[1]}: names the filter, the build, the install and the GUI steps")

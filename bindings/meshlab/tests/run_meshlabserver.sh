@@ -7,7 +7,7 @@
 #   run_meshlabserver.sh mesh WORK IN_LIN.OFF an .mlx script meshes the surface
 #   run_meshlabserver.sh open WORK CLOSED.OFF an open surface (one facet dropped) fails cleanly
 #   run_meshlabserver.sh smooth WORK RAW.OFF  smoothIterations 10 meshes a marching-cubes surface
-#   run_meshlabserver.sh readme WORK IN.OFF   the README's .mlx example ($README) runs
+#   run_meshlabserver.sh readme WORK IN.OFF   docs/meshlab.md's .mlx example ($README) runs
 #
 # Environment (set by CMakeLists.txt): MESHLABSERVER, XVFB_RUN, PLUGIN, CURVETET_CLI, PYTHON,
 # TESTS_DIR, LIBCURVETET (the shared library);
@@ -146,11 +146,11 @@ smooth)
   echo "raw marching-cubes surface: smoothed (10 iterations) and meshed"
   ;;
 readme)
-  # The README's filter script, as printed there, on a surface: runs, and its volume mesh
+  # docs/meshlab.md's filter script, as printed there, on a surface: runs, and its volume mesh
   # passes curvetet check.
   "$PYTHON" - "$README" "$work/curvetet.mlx" <<'PY'
 import sys
-section = open(sys.argv[1]).read().split("\n## MeshLab\n", 1)[1].split("\n## ", 1)[0]
+section = open(sys.argv[1]).read()  # docs/meshlab.md
 open(sys.argv[2], "w").write(section.split("```xml\n", 1)[1].split("```", 1)[0])
 PY
   rc=0
