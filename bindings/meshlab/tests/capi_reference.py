@@ -14,7 +14,8 @@ import sys
 class Options(C.Structure):
     _fields_ = [("struct_size", C.c_uint32), ("alpha", C.c_double), ("size", C.c_double),
                 ("optimize", C.c_int32), ("threads", C.c_uint32), ("progress", C.c_void_p),
-                ("user_data", C.c_void_p), ("uniform_size", C.c_int32)]
+                ("user_data", C.c_void_p), ("uniform_size", C.c_int32),
+                ("thorough", C.c_int32), ("pin_threads", C.c_int32)]
 
 
 def main():
