@@ -39,13 +39,14 @@
 //!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
 //!   instead (for meshio, MMG, TetGen, which do not read the P2 sections).
 
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::P3;
 use crate::mesh::TetMesh;
 
+mod atomic;
 mod cursor;
 mod linear;
 mod lines;
@@ -66,6 +67,7 @@ mod vtu;
 mod vtu_write;
 mod weld;
 
+pub use atomic::{check_output_dir, same_file, write_atomic};
 pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
@@ -348,11 +350,7 @@ fn write_file(path: &Path, view: &MeshView, opts: &WriteOptions) -> Result<()> {
     let format = Format::from_path(path)?;
     check_options(format, opts, view)?;
     view.validate()?;
-    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    let mut w = BufWriter::with_capacity(1 << 20, file);
-    write_view(&mut w, format, view, opts).map_err(|e| Error::io(path, e))?;
-    w.flush().map_err(|e| Error::io(path, e))?;
-    Ok(())
+    write_atomic(path, |w| write_view(w, format, view, opts))
 }
 
 /// Write a P2 tetrahedral mesh and its boundary triangles; the format comes from the
