@@ -101,7 +101,7 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
             return Err(Error::io(
                 path,
                 io::Error::new(
-                    io::ErrorKind::NotADirectory,
+                    io::ErrorKind::InvalidInput,
                     format!("{} is not a directory", dir.display()),
                 ),
             ))
@@ -116,7 +116,7 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
     if fs::metadata(&target).is_ok_and(|m| m.is_dir()) {
         return Err(Error::io(
             path,
-            io::Error::new(io::ErrorKind::IsADirectory, "is a directory"),
+            io::Error::new(io::ErrorKind::InvalidInput, "is a directory"),
         ));
     }
     temporary_beside(&target).map(drop).map_err(|e| {
