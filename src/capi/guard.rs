@@ -139,6 +139,38 @@ pub(crate) unsafe fn input_slice<'a, T>(p: *const T, len: usize, what: &str) -> 
     Ok(unsafe { std::slice::from_raw_parts(p, len) })
 }
 
+/// Error unless `num_nodes` and `num_triangles` fit the library's 32-bit node indices
+/// (checked before any slice is made or memory is reserved from them).
+pub(crate) fn check_counts(num_nodes: usize, num_triangles: usize) -> Result<()> {
+    for (what, n) in [("num_nodes", num_nodes), ("num_triangles", num_triangles)] {
+        if n > u32::MAX as usize {
+            return Err(invalid(format!(
+                "{what} is {n}: at most {} (node indices are 32-bit)",
+                u32::MAX
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `src` copied into a new vector of `N`-element groups, or an error (not an abort) when
+/// the memory cannot be reserved.
+pub(crate) fn copy_groups<T: Copy + Default, const N: usize>(
+    src: &[T],
+    what: &str,
+) -> Result<Vec<[T; N]>> {
+    let n = src.len() / N;
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|e| invalid(format!("{what}: cannot reserve memory for {n} items ({e})")))?;
+    v.extend(src.chunks_exact(N).map(|c| {
+        let mut a = [T::default(); N];
+        a.copy_from_slice(c);
+        a
+    }));
+    Ok(v)
+}
+
 /// `n * k` elements, or an error when it overflows.
 pub(crate) fn times(n: usize, k: usize, what: &str) -> Result<usize> {
     n.checked_mul(k)
