@@ -12,14 +12,29 @@ use curvetet::surface::geometry::{
 };
 use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// The exit codes, shown by `--help` and in docs/cli.md.
+const EXIT_CODES: &str = "\
+Exit codes:
+  0  success
+  1  usage error: unknown or bad option or argument, output equal to the input, ...
+  2  I/O error: a file cannot be read or written (missing, not a regular file, full disk)
+  3  malformed input file (the message gives file:line or byte offset)
+  4  invalid surface (not closed, self-intersecting, ...; the message names the element)
+  5  meshing failed
+  6  the mesh failed its final check (a bug: please report it); `check`: invalid mesh
+  7  cancelled
+Outputs are written to a temporary file beside the target and renamed over it when
+complete: a failed or interrupted run never leaves a partial file under the output's name.";
 
 #[derive(Parser)]
 #[command(
     name = "curvetet",
     version,
+    after_help = EXIT_CODES,
     about = "Quadratic (10-node) curved tetrahedral meshes, directly from a closed quadratic (6-node) triangle surface"
 )]
 struct Cli {
@@ -263,7 +278,18 @@ impl MeshOptions {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            // --help and --version print to stdout and succeed; a usage error exits 1.
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     let r = match cli.cmd {
         Cmd::Mesh(a) => cmd_mesh(&a),
         Cmd::Curve {
@@ -300,8 +326,7 @@ fn main() -> ExitCode {
     }
 }
 
-/// Exit codes: 1 bad arguments, 2 I/O, 3 parse, 4 invalid surface, 5 meshing failed,
-/// 6 invalid mesh, 7 cancelled (the C ABI's status codes).
+/// The exit codes ([`EXIT_CODES`]): the C ABI's status codes.
 fn exit_code(e: &Error) -> u8 {
     match e {
         Error::InvalidArgument(_) => 1,
@@ -311,6 +336,22 @@ fn exit_code(e: &Error) -> u8 {
         Error::MeshingFailed { .. } => 5,
         Error::InvalidMesh { .. } => 6,
         Error::Cancelled => 7,
+    }
+}
+
+/// Print a line of results on stdout. A closed stdout (`curvetet check X | head -1`) is
+/// not an error: the reader has what it wanted, and the exit code still tells the result.
+macro_rules! say {
+    ($($t:tt)*) => {
+        stdout_line(format_args!($($t)*))
+    };
+}
+
+fn stdout_line(args: std::fmt::Arguments) -> Result<(), Error> {
+    use std::io::Write;
+    match writeln!(std::io::stdout().lock(), "{args}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::io("stdout", e)),
+        _ => Ok(()),
     }
 }
 
@@ -400,7 +441,7 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
         });
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| Error::InvalidArgument(e.to_string()))?;
-        std::fs::write(path, text).map_err(|e| Error::io(path, e))?;
+        io::write_atomic(path, |w| w.write_all(text.as_bytes()))?;
     }
     Ok(())
 }
@@ -446,21 +487,65 @@ fn curve_summary(name: &str, s: &Surface, r: &CurveReport) -> String {
     )
 }
 
-/// Fails early, before any work, when `output` is not a format curvetet writes.
-fn check_output(output: &Path) -> Result<(), Error> {
-    let f = io::Format::from_path(output)?;
-    if !f.is_writable() {
-        return Err(Error::InvalidArgument(format!(
-            "{}: .{} is read only; write .msh, .vtu, .vtk or .mesh",
-            output.display(),
-            f.extension()
-        )));
+/// Everything about a command's outputs that can be checked before reading its input, so
+/// that a bad request fails at once and no input is ever overwritten: each mesh output
+/// is a format curvetet writes with these write options; each output's directory exists
+/// and takes new files; no output is the input (also through a link) or another output.
+fn check_outputs(
+    input: Option<&Path>,
+    meshes: &[&Path],
+    others: &[&Path],
+    w: &WriteOptions,
+) -> Result<(), Error> {
+    for &m in meshes {
+        let f = io::Format::from_path(m)?;
+        if !f.is_writable() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: .{} is read only; write .msh, .vtu, .vtk or .mesh",
+                m.display(),
+                f.extension()
+            )));
+        }
+        io::check_write_options(f, w)
+            .map_err(|e| Error::InvalidArgument(format!("{}: {e}", m.display())))?;
+    }
+    let all: Vec<&Path> = meshes.iter().chain(others).copied().collect();
+    for (i, &o) in all.iter().enumerate() {
+        if let Some(input) = input {
+            if io::same_file(input, o) {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: this output is the input file {}; write it to another file",
+                    o.display(),
+                    input.display()
+                )));
+            }
+        }
+        if let Some(&p) = all[..i].iter().find(|&&p| io::same_file(p, o)) {
+            return Err(Error::InvalidArgument(format!(
+                "{} and {} are the same file: give each output its own",
+                p.display(),
+                o.display()
+            )));
+        }
+        io::check_output_dir(o)?;
     }
     Ok(())
 }
 
 fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
-    check_output(&a.output)?;
+    let others: Vec<&Path> = [&a.mesh.report, &a.mesh.plot]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::as_path)
+        .collect();
+    check_outputs(
+        Some(&a.input),
+        &[&a.output],
+        &others,
+        &a.mesh.write.options(),
+    )?;
+    a.mesh.options().validate()?;
+    a.curve.options().validate()?;
     if let Some(budget) = a.max_memory {
         // Reading holds at least the file's bytes' worth of nodes and triangles.
         let len = std::fs::metadata(&a.input)
@@ -496,7 +581,8 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
 }
 
 fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
-    check_output(output)?;
+    check_outputs(Some(input), &[output], &[], &w.options())?;
+    c.options().validate()?;
     let raw = io::read(input)?;
     let name = input.display().to_string();
     if !raw.tri6.is_empty() {
@@ -522,6 +608,15 @@ fn cmd_demo(
     n: usize,
     m: &MeshOptions,
 ) -> Result<(), Error> {
+    let mut meshes = vec![output];
+    meshes.extend(surface_out);
+    let others: Vec<&Path> = [&m.report, &m.plot]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::as_path)
+        .collect();
+    check_outputs(None, &meshes, &others, &m.write.options())?;
+    m.options().validate()?;
     let (big_r, r) = (1.0, 0.35);
     let (nu, nv) = curvetet::surface::demo::torus_resolution(n, big_r, r);
     let (nodes, tris) = curvetet::surface::demo::torus(nu, nv, big_r, r);
@@ -559,6 +654,7 @@ fn cmd_demo(
 }
 
 fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> {
+    check_outputs(Some(input), &[output], &[], &w.options())?;
     let raw = io::read(input)?;
     if raw.tet10.is_empty() {
         let s = io::surface_from_raw(raw, &input.display().to_string())?;
@@ -573,7 +669,7 @@ fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> 
 
 fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Error> {
     let svg = curvetet::mesh::plot::quality_svg(report, title);
-    std::fs::write(path, svg).map_err(|e| Error::io(path, e))?;
+    io::write_atomic(path, |w| w.write_all(svg.as_bytes()))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }
@@ -604,6 +700,9 @@ fn shape_line(s: &Surface) -> String {
 }
 
 fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Result<(), Error> {
+    let plots: Vec<&Path> = plot.into_iter().collect();
+    check_outputs(Some(path), &[], &plots, &WriteOptions::default())?;
+    c.options().validate()?;
     let raw = io::read(path)?;
     let name = path.display().to_string();
     let linear = raw.tri6.is_empty() && !raw.tri3.is_empty();
@@ -627,18 +726,18 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 },
                 "warnings": s.warnings(),
             });
-            println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+            say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
         } else {
-            println!("{name}: valid closed linear surface");
-            println!(
+            say!("{name}: valid closed linear surface")?;
+            say!(
                 "  vertices {}, triangles {}, shells {}, enclosed volume {:.12}",
                 s.corner_nodes().len(),
                 s.triangles().len(),
                 s.shell_count(),
                 s.chord_volume()
-            );
-            println!("  {}", shape_line(&s));
-            println!(
+            )?;
+            say!("  {}", shape_line(&s))?;
+            say!(
                 "  curves to a valid P2 surface (feature angle {} deg): {} of {} edges curved, \
                  {} feature edges, {} straightened by the guards; volume {:.12}, min \
                  cos(curved normal, chord normal) {:.4}",
@@ -649,7 +748,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 r.straightened.fold + r.straightened.intersection,
                 s.volume(),
                 s.min_normal_cosine()
-            );
+            )?;
         }
         return Ok(());
     }
@@ -669,21 +768,21 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 "min_normal_cosine": s.min_normal_cosine(), "warnings": s.warnings(),
                 "triangle_shape": shape_json(&s),
             });
-            println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+            say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
         } else {
-            println!("{name}: valid closed P2 surface");
-            println!(
+            say!("{name}: valid closed P2 surface")?;
+            say!(
                 "  nodes {} ({corners} corners), triangles {}, shells {}",
                 s.nodes().len(),
                 s.triangles().len(),
                 s.shell_count()
-            );
-            println!("  enclosed volume {v:.12} (linear {vl:.12})");
-            println!("  {}", shape_line(&s));
-            println!(
+            )?;
+            say!("  enclosed volume {v:.12} (linear {vl:.12})")?;
+            say!("  {}", shape_line(&s))?;
+            say!(
                 "  min cos(curved normal, chord normal) {:.4}",
                 s.min_normal_cosine()
-            );
+            )?;
         }
         return Ok(());
     }
@@ -700,35 +799,43 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
             "kind": "volume", "file": name, "valid": ok, "conformity": conf,
             "volume_relative_difference": rel, "report": report,
         });
-        println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+        say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
     } else {
         let q = &report.quality;
-        println!(
+        say!(
             "{name}: {} P2 volume mesh",
             if ok { "valid" } else { "INVALID" }
-        );
-        println!(
+        )?;
+        say!(
             "  tets {}, nodes {}, boundary triangles {}",
-            report.num_tets, report.num_nodes, report.num_boundary_faces
-        );
-        println!(
+            report.num_tets,
+            report.num_nodes,
+            report.num_boundary_faces
+        )?;
+        say!(
             "  conforming: {} interior faces shared by two tets, boundary closed",
             conf.interior_faces
-        );
-        println!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved);
-        println!("  certified-invalid elements: {}", report.num_invalid);
-        println!(
+        )?;
+        say!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved)?;
+        say!("  certified-invalid elements: {}", report.num_invalid)?;
+        say!(
             "  scaled Jacobian min {:.4} (certified {:.4}) mean {:.4}",
-            q.scaled_jacobian.min, q.scaled_jacobian_certified.min, q.scaled_jacobian.mean
-        );
-        println!(
+            q.scaled_jacobian.min,
+            q.scaled_jacobian_certified.min,
+            q.scaled_jacobian.mean
+        )?;
+        say!(
             "  skewness max {:.4} mean {:.4}; > 0.85: {}, > 0.9: {}",
-            q.skewness.max, q.skewness.mean, report.skew_above_085, report.skew_above_09
-        );
-        println!(
+            q.skewness.max,
+            q.skewness.mean,
+            report.skew_above_085,
+            report.skew_above_09
+        )?;
+        say!(
             "  dihedral angles {:.2} .. {:.2} deg",
-            q.min_dihedral.min, q.max_dihedral.max
-        );
+            q.min_dihedral.min,
+            q.max_dihedral.max
+        )?;
     }
     if !ok {
         return Err(Error::InvalidMesh {
