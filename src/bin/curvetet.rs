@@ -114,7 +114,8 @@ struct MeshArgs {
     mesh: MeshOptions,
     /// Refuse early, with a clear error, an input that would need more memory than this
     /// (bytes, or with a K, M, G or T suffix, powers of 1024): checked on the file size
-    /// before reading and on an estimate of the meshing peak before meshing.
+    /// before reading and on an estimate of the meshing peak before meshing. Default: the
+    /// memory available when the run starts
     #[arg(long, value_parser = parse_bytes)]
     max_memory: Option<u64>,
 }
@@ -147,6 +148,14 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
         return Err(format!("the memory size must be > 0 (got {s:?})"));
     }
     Ok((v * mult as f64).min(u64::MAX as f64) as u64)
+}
+
+/// The memory the system can give without swapping (Linux's `MemAvailable`), if known.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
 }
 
 fn mib(b: u64) -> String {
@@ -546,17 +555,27 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     )?;
     a.mesh.options().validate()?;
     a.curve.options().validate()?;
-    if let Some(budget) = a.max_memory {
+    // The budget: --max-memory, else the memory available now, so that a request that
+    // cannot finish (a tiny --size) is refused at once rather than swapping for hours.
+    let budget = match a.max_memory {
+        Some(b) => Some((b, format!("--max-memory {}", mib(b)))),
+        None => available_memory().map(|b| {
+            (
+                b,
+                format!("the memory available, {} (--max-memory overrides)", mib(b)),
+            )
+        }),
+    };
+    if let Some((budget, what)) = &budget {
         // Reading holds at least the file's bytes' worth of nodes and triangles.
         let len = std::fs::metadata(&a.input)
             .map_err(|e| Error::io(&a.input, e))?
             .len();
-        if len > budget {
+        if len > *budget {
             return Err(Error::InvalidArgument(format!(
-                "{}: reading this {} file needs more than --max-memory {}",
+                "{}: reading this {} file needs more than {what}",
                 a.input.display(),
                 mib(len),
-                mib(budget)
             )));
         }
     }
@@ -564,16 +583,15 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     // is one thread from start to end.
     let surface = curvetet::threads::pool(a.mesh.threads, true)?
         .install(|| read_surface_any(&a.input, &a.curve))?;
-    if let Some(budget) = a.max_memory {
+    if let Some((budget, what)) = &budget {
         let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
-        if need > budget {
+        if need > *budget {
             return Err(Error::InvalidArgument(format!(
                 "{}: meshing {} triangles needs at least about {} (estimate), more than \
-                 --max-memory {}",
+                 {what}",
                 a.input.display(),
                 surface.triangles().len(),
                 mib(need),
-                mib(budget)
             )));
         }
     }
