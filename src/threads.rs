@@ -18,6 +18,10 @@
 
 use crate::{Error, Result};
 
+/// The name of the pool's workers, followed by their index: a panic on one is always
+/// handed to the thread that called into curvetet (rayon resumes it there).
+pub(crate) const WORKER_PREFIX: &str = "curvetet-worker-";
+
 /// The hard upper bound of [`max_threads`], whatever the machine.
 pub const THREADS_HARD_MAX: usize = 1024;
 
@@ -49,6 +53,7 @@ pub fn pool(threads: usize, pin: bool) -> Result<rayon::ThreadPool> {
     check_threads(threads)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
+        .thread_name(|i| format!("{WORKER_PREFIX}{i}"))
         .build()
         .map_err(|e| Error::InvalidArgument(format!("cannot start {threads} threads: {e}")))?;
     let n = pool.current_num_threads();

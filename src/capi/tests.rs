@@ -557,3 +557,45 @@ fn mesh_write_replaces_a_file_whole_and_reports_a_missing_directory() {
         curvetet_surface_free(s);
     }
 }
+
+#[test]
+fn a_caught_panic_names_its_location_and_prints_nothing() {
+    if std::env::var_os("CURVETET_TEST_PANIC_CHILD").is_some() {
+        // In the child process: a panic inside an entry point, with stderr not captured.
+        let st = status_call("f", || panic!("quiet please"));
+        assert_eq!(st, curvetet_status::CURVETET_ERR_PANIC);
+        return;
+    }
+    let line = line!() + 1;
+    let st = status_call("f", || panic!("located"));
+    assert_eq!(st, curvetet_status::CURVETET_ERR_PANIC);
+    let msg = last_error();
+    assert!(
+        msg.contains(&format!("src/capi/tests.rs:{line}")) && msg.contains("located"),
+        "{msg}"
+    );
+    // The same test in a child process, whose stderr is not captured by the test
+    // harness: Rust's default hook would print "panicked at ... quiet please" there.
+    let o = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "capi::tests::a_caught_panic_names_its_location_and_prints_nothing",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("CURVETET_TEST_PANIC_CHILD", "1")
+        .output()
+        .unwrap();
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(
+        o.status.success() && out.contains("1 passed"),
+        "{out}\n{err}"
+    );
+    assert!(
+        !err.contains("quiet please") && !out.contains("quiet please"),
+        "{err}"
+    );
+}
