@@ -659,3 +659,60 @@ fn concurrent_writers_of_one_path_leave_one_complete_file() {
         assert_eq!(names_in(&d), ["out.vtu"], "round {round}");
     }
 }
+
+#[test]
+fn a_convert_interrupted_while_writing_leaves_the_old_file_and_no_temporary() {
+    use std::os::unix::process::ExitStatusExt;
+    let d = scratch("sigterm");
+    // A volume mesh of a few megabytes: its conversion writes for tens of milliseconds.
+    let input = tmp("sigterm-big.msh");
+    let o = run(&[
+        "demo",
+        "-q",
+        "--triangles",
+        "6000",
+        "--no-optimize",
+        "-o",
+        s(&input),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out = d.join("out.vtu");
+    let old = b"the previous contents".to_vec();
+    let mut caught = 0;
+    for _ in 0..20 {
+        std::fs::write(&out, &old).unwrap();
+        let mut child = Command::new(bin())
+            .args(["convert", s(&input), s(&out)])
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Wait for the temporary file to appear, then interrupt the write.
+        let t = Instant::now();
+        let writing = loop {
+            if names_in(&d).iter().any(|n| n.starts_with(".out.vtu.")) {
+                break true;
+            }
+            if child.try_wait().unwrap().is_some() || t.elapsed() > Duration::from_secs(10) {
+                break false;
+            }
+        };
+        if !writing {
+            let _ = child.kill();
+            child.wait().unwrap();
+            continue;
+        }
+        // SAFETY: a signal to our own child.
+        unsafe { libc::kill(child.id() as i32, libc::SIGTERM) };
+        let status = child.wait().unwrap();
+        if status.signal() != Some(libc::SIGTERM) {
+            continue; // finished before the signal arrived
+        }
+        caught += 1;
+        assert_eq!(std::fs::read(&out).unwrap(), old, "the target changed");
+        assert_eq!(names_in(&d), ["out.vtu"], "a temporary file was left");
+        if caught == 3 {
+            break;
+        }
+    }
+    assert!(caught > 0, "never caught a convert while it was writing");
+}

@@ -286,7 +286,46 @@ impl MeshOptions {
     }
 }
 
+/// On SIGINT, SIGTERM or SIGHUP, remove the temporary files of the outputs being written
+/// and end by that signal: an interrupted run leaves its outputs as they were. The
+/// signals are blocked in every thread (the workers inherit it) and taken by one thread
+/// that waits for them.
+#[cfg(unix)]
+fn clean_up_on_signals() {
+    // SAFETY: plain libc signal-mask calls on a local, zero-initialised set.
+    let set = unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, s);
+        }
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        set
+    };
+    std::thread::spawn(move || loop {
+        let mut sig = 0;
+        // SAFETY: waits on a valid set.
+        if unsafe { libc::sigwait(&set, &mut sig) } != 0 {
+            continue;
+        }
+        io::remove_unfinished_temporaries();
+        // SAFETY: restore the default action and deliver the signal to this thread, which
+        // ends the process as if the signal had not been caught.
+        unsafe {
+            libc::signal(sig, libc::SIG_DFL);
+            libc::pthread_sigmask(libc::SIG_UNBLOCK, &set, std::ptr::null_mut());
+            libc::raise(sig);
+        }
+    });
+}
+
+#[cfg(not(unix))]
+fn clean_up_on_signals() {}
+
 fn main() -> ExitCode {
+    clean_up_on_signals();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {

@@ -12,8 +12,43 @@
 use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::error::{Error, Result};
+
+/// The temporary files being written now, for [`remove_unfinished_temporaries`].
+static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Keeps a temporary file's path in [`UNFINISHED`] while it is written.
+struct Unfinished(PathBuf);
+
+impl Unfinished {
+    fn new(path: &Path) -> Unfinished {
+        let mut list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+        list.push(path.to_path_buf());
+        Unfinished(path.to_path_buf())
+    }
+}
+
+impl Drop for Unfinished {
+    fn drop(&mut self) {
+        let mut list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(i) = list.iter().position(|p| *p == self.0) {
+            list.swap_remove(i);
+        }
+    }
+}
+
+/// Remove the temporary files of the writes in progress, for a program about to end on a
+/// signal (Ctrl-C, SIGTERM) while writing: its targets stay as they were, and nothing is
+/// left beside them. Call it from a thread that waits for the signals (not from a signal
+/// handler: it takes a lock), then end the process; the interrupted writes fail.
+pub fn remove_unfinished_temporaries() {
+    let list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
+    for p in list.iter() {
+        let _ = fs::remove_file(p);
+    }
+}
 
 /// The directory a file named `path` lives in (`.` for a bare file name).
 fn dir_of(path: &Path) -> &Path {
@@ -66,6 +101,7 @@ pub fn write_atomic(
     let target = target_of(path);
     let err = |e| Error::io(path, e);
     let mut tmp = temporary_beside(&target).map_err(err)?;
+    let _unfinished = Unfinished::new(tmp.path());
     {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
         write(&mut w).map_err(err)?;
@@ -119,12 +155,16 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
             io::Error::new(io::ErrorKind::InvalidInput, "is a directory"),
         ));
     }
-    temporary_beside(&target).map(drop).map_err(|e| {
-        Error::io(
-            path,
-            io::Error::new(e.kind(), format!("cannot write in {}: {e}", dir.display())),
-        )
-    })
+    tempfile::Builder::new()
+        .prefix(".curvetet-probe.")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|e| {
+            Error::io(
+                path,
+                io::Error::new(e.kind(), format!("cannot write in {}: {e}", dir.display())),
+            )
+        })
 }
 
 /// `path` with symbolic links and `..` resolved; for a file that does not exist yet, its

@@ -67,7 +67,7 @@ mod vtu;
 mod vtu_write;
 mod weld;
 
-pub use atomic::{check_output_dir, same_file, write_atomic};
+pub use atomic::{check_output_dir, remove_unfinished_temporaries, same_file, write_atomic};
 pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
