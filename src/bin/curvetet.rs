@@ -171,7 +171,7 @@ struct CurveArgs {
     /// For a linear input surface: Taubin-smooth its vertices with this many iterations
     /// before curving. For surfaces from image segmentation (marching cubes), whose needle
     /// and cap triangles leave the front stuck: 10 makes them well shaped. Moves the
-    /// surface (by a fraction of a voxel) and rounds sharp edges
+    /// surface (by a fraction of a voxel) and rounds sharp edges. At most 1000
     #[arg(long, default_value_t = 0)]
     smooth: u32,
 }
@@ -210,7 +210,8 @@ struct MeshOptions {
     /// worst one and min J / max J 0.85; the worst is about as good either way
     #[arg(long, conflicts_with = "no_optimize")]
     thorough: bool,
-    /// Worker threads (0 = all cores); the result does not depend on it.
+    /// Worker threads (0 = all cores; at most 4 per CPU and at most 1024); the result does
+    /// not depend on it.
     #[arg(long, default_value_t = 0)]
     threads: usize,
     /// Write the quality report as JSON here.
@@ -242,7 +243,7 @@ struct WriteArgs {
     /// Write Gmsh MSH 2.2 instead of 4.1.
     #[arg(long)]
     msh22: bool,
-    /// Write binary (.msh only).
+    /// Write binary (.msh, or .vtu with base64 arrays; not available for .vtk and .mesh).
     #[arg(long)]
     binary: bool,
 }
