@@ -23,10 +23,16 @@ static UNFINISHED: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 struct Unfinished(PathBuf);
 
 impl Unfinished {
-    fn new(path: &Path) -> Unfinished {
+    /// Creates a temporary file with `make` and registers it, holding the registry's lock
+    /// throughout: a signal taken meanwhile waits, then finds the file registered.
+    fn create(
+        make: impl FnOnce() -> io::Result<tempfile::NamedTempFile>,
+    ) -> io::Result<(tempfile::NamedTempFile, Unfinished)> {
         let mut list = UNFINISHED.lock().unwrap_or_else(|e| e.into_inner());
-        list.push(path.to_path_buf());
-        Unfinished(path.to_path_buf())
+        let tmp = make()?;
+        list.push(tmp.path().to_path_buf());
+        let path = tmp.path().to_path_buf();
+        Ok((tmp, Unfinished(path)))
     }
 }
 
@@ -100,8 +106,7 @@ pub fn write_atomic(
 ) -> Result<()> {
     let target = target_of(path);
     let err = |e| Error::io(path, e);
-    let mut tmp = temporary_beside(&target).map_err(err)?;
-    let _unfinished = Unfinished::new(tmp.path());
+    let (mut tmp, _unfinished) = Unfinished::create(|| temporary_beside(&target)).map_err(err)?;
     {
         let mut w = BufWriter::with_capacity(1 << 20, tmp.as_file_mut());
         write(&mut w).map_err(err)?;
@@ -155,16 +160,18 @@ pub fn check_output_dir(path: &Path) -> Result<()> {
             io::Error::new(io::ErrorKind::InvalidInput, "is a directory"),
         ));
     }
-    tempfile::Builder::new()
-        .prefix(".curvetet-probe.")
-        .tempfile_in(dir)
-        .map(drop)
-        .map_err(|e| {
-            Error::io(
-                path,
-                io::Error::new(e.kind(), format!("cannot write in {}: {e}", dir.display())),
-            )
-        })
+    Unfinished::create(|| {
+        tempfile::Builder::new()
+            .prefix(".curvetet-probe.")
+            .tempfile_in(dir)
+    })
+    .map(drop)
+    .map_err(|e| {
+        Error::io(
+            path,
+            io::Error::new(e.kind(), format!("cannot write in {}: {e}", dir.display())),
+        )
+    })
 }
 
 /// `path` with symbolic links and `..` resolved; for a file that does not exist yet, its
