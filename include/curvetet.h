@@ -183,6 +183,8 @@ typedef struct curvetet_options {
      * Worker threads for the parallel stages; 0 (default): one per CPU. The pool is
      * created by each `curvetet_generate` call and gone when it returns; the front and
      * the progress callback run on the calling thread. The result does not depend on it.
+     * At most 4 per CPU and at most 1024: more is `CURVETET_ERR_INVALID_ARGUMENT`,
+     * before any work.
      */
     uint32_t threads;
     /**
@@ -508,7 +510,8 @@ double curvetet_mesh_target_size(const struct curvetet_mesh *m);
  * On success `*out` is a new surface the caller owns (free it with
  * `curvetet_surface_free`). On failure `*out` is NULL and the status is
  * `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, count
- * overflow) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and
+ * overflow, a count above 4294967295 (node indices are 32-bit), or no memory for the
+ * copy: never an abort) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and
  * the triangle, edge or node).
  *
  * # Safety
@@ -535,8 +538,8 @@ enum curvetet_status curvetet_surface_from_arrays(const double *xyz,
  *
  * On success `*out` is a new surface the caller owns (free it with
  * `curvetet_surface_free`). On failure `*out` is NULL and the status is
- * `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, bad
- * angle) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and the
+ * `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, a count
+ * above 4294967295, bad angle, more than 1000 smoothing iterations) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and the
  * facet, edge or vertex).
  *
  * # Safety

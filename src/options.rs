@@ -53,7 +53,8 @@ pub struct Options {
     /// the threshold (screw: 78 instead of 204 of 734 below min J / max J 0.85); the
     /// worst element is about as good either way.
     pub thorough: bool,
-    /// Worker threads for parallel stages; 0 = all cores. Results never depend on it.
+    /// Worker threads for parallel stages; 0 = all cores. Results never depend on it. At
+    /// most [`crate::threads::max_threads`] (4 per CPU, at most 1024).
     pub threads: usize,
     /// Keep each worker of a pool with one worker per CPU on its own CPU (see
     /// [`crate::threads`]). Off by default: a host application (VTK, ParaView, Gmsh,
@@ -104,6 +105,7 @@ impl Options {
                 )));
             }
         }
+        crate::threads::check_threads(self.threads)?;
         if !(self.gradation.is_finite() && self.gradation > 0.0) {
             return Err(Error::InvalidArgument(format!(
                 "gradation must be a finite number > 0 (got {})",

@@ -18,11 +18,42 @@
 
 use crate::{Error, Result};
 
+/// The name of the pool's workers, followed by their index: a panic on one is always
+/// handed to the thread that called into curvetet (rayon resumes it there).
+pub(crate) const WORKER_PREFIX: &str = "curvetet-worker-";
+
+/// The hard upper bound of [`max_threads`], whatever the machine.
+pub const THREADS_HARD_MAX: usize = 1024;
+
+/// The most worker threads a caller may ask for: 4 per CPU the process may use, at most
+/// [`THREADS_HARD_MAX`]. More gain nothing (the work is CPU bound) and a mistyped count
+/// would otherwise start thousands of threads before failing.
+pub fn max_threads() -> usize {
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    cpus.saturating_mul(4).min(THREADS_HARD_MAX)
+}
+
+/// An [`Error::InvalidArgument`] when `threads` is above [`max_threads`] (0, all CPUs, is
+/// always accepted).
+pub fn check_threads(threads: usize) -> Result<()> {
+    let max = max_threads();
+    if threads > max {
+        return Err(Error::InvalidArgument(format!(
+            "{threads} threads: at most {max} (4 per CPU, at most {THREADS_HARD_MAX}); 0 uses \
+             every CPU"
+        )));
+    }
+    Ok(())
+}
+
 /// A rayon pool of `threads` workers (0: as many as rayon chooses, one per CPU by
 /// default), pinned as the module docs say when `pin` (or `CURVETET_PIN_THREADS`) asks.
+/// More than [`max_threads`] is an error.
 pub fn pool(threads: usize, pin: bool) -> Result<rayon::ThreadPool> {
+    check_threads(threads)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
+        .thread_name(|i| format!("{WORKER_PREFIX}{i}"))
         .build()
         .map_err(|e| Error::InvalidArgument(format!("cannot start {threads} threads: {e}")))?;
     let n = pool.current_num_threads();
@@ -91,6 +122,20 @@ mod tests {
     #[cfg(target_os = "linux")]
     fn worker_cpus(p: &rayon::ThreadPool) -> Vec<Vec<usize>> {
         p.broadcast(|_| allowed_cpus())
+    }
+
+    #[test]
+    fn thread_counts_above_the_cap_are_refused_at_once() {
+        let max = max_threads();
+        assert!((4..=THREADS_HARD_MAX).contains(&max), "{max}");
+        assert!(check_threads(0).is_ok() && check_threads(max).is_ok());
+        let t = std::time::Instant::now();
+        for n in [max + 1, 100_000, usize::MAX] {
+            let e = pool(n, false).unwrap_err();
+            assert!(matches!(e, Error::InvalidArgument(_)), "{e}");
+            assert!(e.to_string().contains(&format!("at most {max}")), "{e}");
+        }
+        assert!(t.elapsed() < std::time::Duration::from_secs(1));
     }
 
     #[cfg(target_os = "linux")]

@@ -437,3 +437,16 @@ fn unsupported_variants_say_so() {
         assert!(e.contains(want), "expected '{want}' in '{e}'");
     }
 }
+
+#[test]
+fn deeply_nested_xml_is_an_error_without_a_large_allocation() {
+    // A VTU header then a megabyte of unclosed tags: refused at the nesting bound, long
+    // before the reader holds one name per open tag.
+    let mut b = b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\">".to_vec();
+    for _ in 0..300_000 {
+        b.extend_from_slice(b"<a>");
+    }
+    let e = expect_err(&b, Format::Vtu, "unclosed tags");
+    assert!(e.contains("nested more than 64 deep"), "{e}");
+    assert_small_allocations();
+}

@@ -12,14 +12,29 @@ use curvetet::surface::geometry::{
 };
 use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// The exit codes, shown by `--help` and in docs/cli.md.
+const EXIT_CODES: &str = "\
+Exit codes:
+  0  success
+  1  usage error: unknown or bad option or argument, output equal to the input, ...
+  2  I/O error: a file cannot be read or written (missing, not a regular file, full disk)
+  3  malformed input file (the message gives file:line or byte offset)
+  4  invalid surface (not closed, self-intersecting, ...; the message names the element)
+  5  meshing failed
+  6  the mesh failed its final check (a bug: please report it); `check`: invalid mesh
+  7  cancelled
+Outputs are written to a temporary file beside the target and renamed over it when
+complete: a failed or interrupted run never leaves a partial file under the output's name.";
 
 #[derive(Parser)]
 #[command(
     name = "curvetet",
     version,
+    after_help = EXIT_CODES,
     about = "Quadratic (10-node) curved tetrahedral meshes, directly from a closed quadratic (6-node) triangle surface"
 )]
 struct Cli {
@@ -99,7 +114,8 @@ struct MeshArgs {
     mesh: MeshOptions,
     /// Refuse early, with a clear error, an input that would need more memory than this
     /// (bytes, or with a K, M, G or T suffix, powers of 1024): checked on the file size
-    /// before reading and on an estimate of the meshing peak before meshing.
+    /// before reading and on an estimate of the meshing peak before meshing. Default: the
+    /// memory available when the run starts
     #[arg(long, value_parser = parse_bytes)]
     max_memory: Option<u64>,
 }
@@ -134,6 +150,14 @@ fn parse_bytes(s: &str) -> Result<u64, String> {
     Ok((v * mult as f64).min(u64::MAX as f64) as u64)
 }
 
+/// The memory the system can give without swapping (Linux's `MemAvailable`), if known.
+fn available_memory() -> Option<u64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib.saturating_mul(1024))
+}
+
 fn mib(b: u64) -> String {
     format!("{:.1} MiB", b as f64 / (1u64 << 20) as f64)
 }
@@ -147,7 +171,7 @@ struct CurveArgs {
     /// For a linear input surface: Taubin-smooth its vertices with this many iterations
     /// before curving. For surfaces from image segmentation (marching cubes), whose needle
     /// and cap triangles leave the front stuck: 10 makes them well shaped. Moves the
-    /// surface (by a fraction of a voxel) and rounds sharp edges
+    /// surface (by a fraction of a voxel) and rounds sharp edges. At most 1000
     #[arg(long, default_value_t = 0)]
     smooth: u32,
 }
@@ -186,7 +210,8 @@ struct MeshOptions {
     /// worst one and min J / max J 0.85; the worst is about as good either way
     #[arg(long, conflicts_with = "no_optimize")]
     thorough: bool,
-    /// Worker threads (0 = all cores); the result does not depend on it.
+    /// Worker threads (0 = all cores; at most 4 per CPU and at most 1024); the result does
+    /// not depend on it.
     #[arg(long, default_value_t = 0)]
     threads: usize,
     /// Write the quality report as JSON here.
@@ -218,7 +243,7 @@ struct WriteArgs {
     /// Write Gmsh MSH 2.2 instead of 4.1.
     #[arg(long)]
     msh22: bool,
-    /// Write binary (.msh only).
+    /// Write binary (.msh, or .vtu with base64 arrays; not available for .vtk and .mesh).
     #[arg(long)]
     binary: bool,
 }
@@ -262,8 +287,58 @@ impl MeshOptions {
     }
 }
 
+/// On SIGINT, SIGTERM or SIGHUP, remove the temporary files of the outputs being written
+/// and end by that signal: an interrupted run leaves its outputs as they were. The
+/// signals are blocked in every thread (the workers inherit it) and taken by one thread
+/// that waits for them.
+#[cfg(unix)]
+fn clean_up_on_signals() {
+    // SAFETY: plain libc signal-mask calls on a local, zero-initialised set.
+    let set = unsafe {
+        let mut set: libc::sigset_t = std::mem::zeroed();
+        libc::sigemptyset(&mut set);
+        for s in [libc::SIGINT, libc::SIGTERM, libc::SIGHUP] {
+            libc::sigaddset(&mut set, s);
+        }
+        if libc::pthread_sigmask(libc::SIG_BLOCK, &set, std::ptr::null_mut()) != 0 {
+            return;
+        }
+        set
+    };
+    std::thread::spawn(move || loop {
+        let mut sig = 0;
+        // SAFETY: waits on a valid set.
+        if unsafe { libc::sigwait(&set, &mut sig) } != 0 {
+            continue;
+        }
+        io::remove_unfinished_temporaries();
+        // SAFETY: restore the default action and deliver the signal to this thread, which
+        // ends the process as if the signal had not been caught.
+        unsafe {
+            libc::signal(sig, libc::SIG_DFL);
+            libc::pthread_sigmask(libc::SIG_UNBLOCK, &set, std::ptr::null_mut());
+            libc::raise(sig);
+        }
+    });
+}
+
+#[cfg(not(unix))]
+fn clean_up_on_signals() {}
+
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    clean_up_on_signals();
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            // --help and --version print to stdout and succeed; a usage error exits 1.
+            let _ = e.print();
+            return if e.use_stderr() {
+                ExitCode::from(1)
+            } else {
+                ExitCode::SUCCESS
+            };
+        }
+    };
     let r = match cli.cmd {
         Cmd::Mesh(a) => cmd_mesh(&a),
         Cmd::Curve {
@@ -300,8 +375,7 @@ fn main() -> ExitCode {
     }
 }
 
-/// Exit codes: 1 bad arguments, 2 I/O, 3 parse, 4 invalid surface, 5 meshing failed,
-/// 6 invalid mesh, 7 cancelled (the C ABI's status codes).
+/// The exit codes ([`EXIT_CODES`]): the C ABI's status codes.
 fn exit_code(e: &Error) -> u8 {
     match e {
         Error::InvalidArgument(_) => 1,
@@ -311,6 +385,22 @@ fn exit_code(e: &Error) -> u8 {
         Error::MeshingFailed { .. } => 5,
         Error::InvalidMesh { .. } => 6,
         Error::Cancelled => 7,
+    }
+}
+
+/// Print a line of results on stdout. A closed stdout (`curvetet check X | head -1`) is
+/// not an error: the reader has what it wanted, and the exit code still tells the result.
+macro_rules! say {
+    ($($t:tt)*) => {
+        stdout_line(format_args!($($t)*))
+    };
+}
+
+fn stdout_line(args: std::fmt::Arguments) -> Result<(), Error> {
+    use std::io::Write;
+    match writeln!(std::io::stdout().lock(), "{args}") {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => Err(Error::io("stdout", e)),
+        _ => Ok(()),
     }
 }
 
@@ -400,7 +490,7 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
         });
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| Error::InvalidArgument(e.to_string()))?;
-        std::fs::write(path, text).map_err(|e| Error::io(path, e))?;
+        io::write_atomic(path, |w| w.write_all(text.as_bytes()))?;
     }
     Ok(())
 }
@@ -446,32 +536,86 @@ fn curve_summary(name: &str, s: &Surface, r: &CurveReport) -> String {
     )
 }
 
-/// Fails early, before any work, when `output` is not a format curvetet writes.
-fn check_output(output: &Path) -> Result<(), Error> {
-    let f = io::Format::from_path(output)?;
-    if !f.is_writable() {
-        return Err(Error::InvalidArgument(format!(
-            "{}: .{} is read only; write .msh, .vtu, .vtk or .mesh",
-            output.display(),
-            f.extension()
-        )));
+/// Everything about a command's outputs that can be checked before reading its input, so
+/// that a bad request fails at once and no input is ever overwritten: each mesh output
+/// is a format curvetet writes with these write options; each output's directory exists
+/// and takes new files; no output is the input (also through a link) or another output.
+fn check_outputs(
+    input: Option<&Path>,
+    meshes: &[&Path],
+    others: &[&Path],
+    w: &WriteOptions,
+) -> Result<(), Error> {
+    for &m in meshes {
+        let f = io::Format::from_path(m)?;
+        if !f.is_writable() {
+            return Err(Error::InvalidArgument(format!(
+                "{}: .{} is read only; write .msh, .vtu, .vtk or .mesh",
+                m.display(),
+                f.extension()
+            )));
+        }
+        io::check_write_options(f, w)
+            .map_err(|e| Error::InvalidArgument(format!("{}: {e}", m.display())))?;
+    }
+    let all: Vec<&Path> = meshes.iter().chain(others).copied().collect();
+    for (i, &o) in all.iter().enumerate() {
+        if let Some(input) = input {
+            if io::same_file(input, o) {
+                return Err(Error::InvalidArgument(format!(
+                    "{}: this output is the input file {}; write it to another file",
+                    o.display(),
+                    input.display()
+                )));
+            }
+        }
+        if let Some(&p) = all[..i].iter().find(|&&p| io::same_file(p, o)) {
+            return Err(Error::InvalidArgument(format!(
+                "{} and {} are the same file: give each output its own",
+                p.display(),
+                o.display()
+            )));
+        }
+        io::check_output_dir(o)?;
     }
     Ok(())
 }
 
 fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
-    check_output(&a.output)?;
-    if let Some(budget) = a.max_memory {
+    let others: Vec<&Path> = [&a.mesh.report, &a.mesh.plot]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::as_path)
+        .collect();
+    check_outputs(
+        Some(&a.input),
+        &[&a.output],
+        &others,
+        &a.mesh.write.options(),
+    )?;
+    a.mesh.options().validate()?;
+    a.curve.options().validate()?;
+    // The budget: --max-memory, else the memory available now, so that a request that
+    // cannot finish (a tiny --size) is refused at once rather than swapping for hours.
+    let budget = match a.max_memory {
+        Some(b) => Some((b, format!("--max-memory {}", mib(b)))),
+        None => available_memory().map(|b| {
+            (
+                b,
+                format!("the memory available, {} (--max-memory overrides)", mib(b)),
+            )
+        }),
+    };
+    if let Some((budget, what)) = &budget {
         // Reading holds at least the file's bytes' worth of nodes and triangles.
         let len = std::fs::metadata(&a.input)
             .map_err(|e| Error::io(&a.input, e))?
             .len();
-        if len > budget {
+        if len > *budget {
             return Err(Error::InvalidArgument(format!(
-                "{}: reading this {} file needs more than --max-memory {}",
+                "{}: reading this {} file needs more than {what}",
                 a.input.display(),
                 mib(len),
-                mib(budget)
             )));
         }
     }
@@ -479,16 +623,15 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     // is one thread from start to end.
     let surface = curvetet::threads::pool(a.mesh.threads, true)?
         .install(|| read_surface_any(&a.input, &a.curve))?;
-    if let Some(budget) = a.max_memory {
+    if let Some((budget, what)) = &budget {
         let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
-        if need > budget {
+        if need > *budget {
             return Err(Error::InvalidArgument(format!(
                 "{}: meshing {} triangles needs at least about {} (estimate), more than \
-                 --max-memory {}",
+                 {what}",
                 a.input.display(),
                 surface.triangles().len(),
                 mib(need),
-                mib(budget)
             )));
         }
     }
@@ -496,7 +639,8 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
 }
 
 fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
-    check_output(output)?;
+    check_outputs(Some(input), &[output], &[], &w.options())?;
+    c.options().validate()?;
     let raw = io::read(input)?;
     let name = input.display().to_string();
     if !raw.tri6.is_empty() {
@@ -522,6 +666,15 @@ fn cmd_demo(
     n: usize,
     m: &MeshOptions,
 ) -> Result<(), Error> {
+    let mut meshes = vec![output];
+    meshes.extend(surface_out);
+    let others: Vec<&Path> = [&m.report, &m.plot]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::as_path)
+        .collect();
+    check_outputs(None, &meshes, &others, &m.write.options())?;
+    m.options().validate()?;
     let (big_r, r) = (1.0, 0.35);
     let (nu, nv) = curvetet::surface::demo::torus_resolution(n, big_r, r);
     let (nodes, tris) = curvetet::surface::demo::torus(nu, nv, big_r, r);
@@ -559,6 +712,7 @@ fn cmd_demo(
 }
 
 fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> {
+    check_outputs(Some(input), &[output], &[], &w.options())?;
     let raw = io::read(input)?;
     if raw.tet10.is_empty() {
         let s = io::surface_from_raw(raw, &input.display().to_string())?;
@@ -573,7 +727,7 @@ fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> 
 
 fn write_plot(path: &Path, report: &QualityReport, title: &str) -> Result<(), Error> {
     let svg = curvetet::mesh::plot::quality_svg(report, title);
-    std::fs::write(path, svg).map_err(|e| Error::io(path, e))?;
+    io::write_atomic(path, |w| w.write_all(svg.as_bytes()))?;
     eprintln!("wrote {}", path.display());
     Ok(())
 }
@@ -604,6 +758,9 @@ fn shape_line(s: &Surface) -> String {
 }
 
 fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Result<(), Error> {
+    let plots: Vec<&Path> = plot.into_iter().collect();
+    check_outputs(Some(path), &[], &plots, &WriteOptions::default())?;
+    c.options().validate()?;
     let raw = io::read(path)?;
     let name = path.display().to_string();
     let linear = raw.tri6.is_empty() && !raw.tri3.is_empty();
@@ -627,18 +784,18 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 },
                 "warnings": s.warnings(),
             });
-            println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+            say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
         } else {
-            println!("{name}: valid closed linear surface");
-            println!(
+            say!("{name}: valid closed linear surface")?;
+            say!(
                 "  vertices {}, triangles {}, shells {}, enclosed volume {:.12}",
                 s.corner_nodes().len(),
                 s.triangles().len(),
                 s.shell_count(),
                 s.chord_volume()
-            );
-            println!("  {}", shape_line(&s));
-            println!(
+            )?;
+            say!("  {}", shape_line(&s))?;
+            say!(
                 "  curves to a valid P2 surface (feature angle {} deg): {} of {} edges curved, \
                  {} feature edges, {} straightened by the guards; volume {:.12}, min \
                  cos(curved normal, chord normal) {:.4}",
@@ -649,7 +806,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 r.straightened.fold + r.straightened.intersection,
                 s.volume(),
                 s.min_normal_cosine()
-            );
+            )?;
         }
         return Ok(());
     }
@@ -669,21 +826,21 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
                 "min_normal_cosine": s.min_normal_cosine(), "warnings": s.warnings(),
                 "triangle_shape": shape_json(&s),
             });
-            println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+            say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
         } else {
-            println!("{name}: valid closed P2 surface");
-            println!(
+            say!("{name}: valid closed P2 surface")?;
+            say!(
                 "  nodes {} ({corners} corners), triangles {}, shells {}",
                 s.nodes().len(),
                 s.triangles().len(),
                 s.shell_count()
-            );
-            println!("  enclosed volume {v:.12} (linear {vl:.12})");
-            println!("  {}", shape_line(&s));
-            println!(
+            )?;
+            say!("  enclosed volume {v:.12} (linear {vl:.12})")?;
+            say!("  {}", shape_line(&s))?;
+            say!(
                 "  min cos(curved normal, chord normal) {:.4}",
                 s.min_normal_cosine()
-            );
+            )?;
         }
         return Ok(());
     }
@@ -700,35 +857,43 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
             "kind": "volume", "file": name, "valid": ok, "conformity": conf,
             "volume_relative_difference": rel, "report": report,
         });
-        println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
+        say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
     } else {
         let q = &report.quality;
-        println!(
+        say!(
             "{name}: {} P2 volume mesh",
             if ok { "valid" } else { "INVALID" }
-        );
-        println!(
+        )?;
+        say!(
             "  tets {}, nodes {}, boundary triangles {}",
-            report.num_tets, report.num_nodes, report.num_boundary_faces
-        );
-        println!(
+            report.num_tets,
+            report.num_nodes,
+            report.num_boundary_faces
+        )?;
+        say!(
             "  conforming: {} interior faces shared by two tets, boundary closed",
             conf.interior_faces
-        );
-        println!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved);
-        println!("  certified-invalid elements: {}", report.num_invalid);
-        println!(
+        )?;
+        say!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved)?;
+        say!("  certified-invalid elements: {}", report.num_invalid)?;
+        say!(
             "  scaled Jacobian min {:.4} (certified {:.4}) mean {:.4}",
-            q.scaled_jacobian.min, q.scaled_jacobian_certified.min, q.scaled_jacobian.mean
-        );
-        println!(
+            q.scaled_jacobian.min,
+            q.scaled_jacobian_certified.min,
+            q.scaled_jacobian.mean
+        )?;
+        say!(
             "  skewness max {:.4} mean {:.4}; > 0.85: {}, > 0.9: {}",
-            q.skewness.max, q.skewness.mean, report.skew_above_085, report.skew_above_09
-        );
-        println!(
+            q.skewness.max,
+            q.skewness.mean,
+            report.skew_above_085,
+            report.skew_above_09
+        )?;
+        say!(
             "  dihedral angles {:.2} .. {:.2} deg",
-            q.min_dihedral.min, q.max_dihedral.max
-        );
+            q.min_dihedral.min,
+            q.max_dihedral.max
+        )?;
     }
     if !ok {
         return Err(Error::InvalidMesh {

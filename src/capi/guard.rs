@@ -3,11 +3,63 @@
 //! Since Rust 1.81 a panic unwinding out of an `extern "C"` function aborts the host
 //! process, so every entry point runs its body inside [`status_call`] or [`value_call`],
 //! which catch the panic and turn it into `CURVETET_ERR_PANIC` with the panic message.
+//!
+//! A caught panic is the caller's to report, through the status and the message: Rust's
+//! default panic hook would also print it to the host's stderr. So the first entry point
+//! called wraps the process's panic hook once ([`quiet_hook`]): a panic on a thread that
+//! is inside an entry point, or on one of curvetet's worker threads, prints nothing and
+//! leaves its location for the message; any other panic goes to the previous hook as
+//! before (the host's own panics, if the host is Rust, are untouched).
 
 use super::status::{clear_last_error, curvetet_status, set_last_error};
 use crate::{Error, Result};
 use std::any::Any;
+use std::cell::{Cell, RefCell};
 use std::panic::{catch_unwind, AssertUnwindSafe};
+
+thread_local! {
+    /// How many entry points this thread is inside (callbacks may call back in).
+    static IN_CALL: Cell<u32> = const { Cell::new(0) };
+    /// Where this thread's last caught panic happened, for its message.
+    static PANIC_AT: RefCell<Option<String>> = const { RefCell::new(None) };
+}
+
+/// Install [`quiet_hook`] once, in front of whatever hook the process has.
+fn install_quiet_hook() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| quiet_hook(info, &*previous)));
+    });
+}
+
+/// The panic hook of the module docs.
+fn quiet_hook(
+    info: &std::panic::PanicHookInfo,
+    previous: &(dyn Fn(&std::panic::PanicHookInfo) + Send + Sync),
+) {
+    let ours = IN_CALL.try_with(|c| c.get() > 0).unwrap_or(false)
+        || std::thread::current()
+            .name()
+            .is_some_and(|n| n.starts_with(crate::threads::WORKER_PREFIX));
+    if !ours {
+        return previous(info);
+    }
+    let at = info
+        .location()
+        .map(|l| format!("{}:{}", l.file(), l.line()));
+    let _ = PANIC_AT.try_with(|p| p.try_borrow_mut().map(|mut p| *p = at));
+}
+
+/// Runs `body` as an entry point's: inside it this thread's panics are quiet.
+fn in_call<T>(body: impl FnOnce() -> T) -> std::thread::Result<T> {
+    install_quiet_hook();
+    let _ = PANIC_AT.try_with(|p| p.try_borrow_mut().map(|mut p| *p = None));
+    let _ = IN_CALL.try_with(|c| c.set(c.get() + 1));
+    let r = catch_unwind(AssertUnwindSafe(body));
+    let _ = IN_CALL.try_with(|c| c.set(c.get().saturating_sub(1)));
+    r
+}
 
 /// The text of a panic payload (`panic!` gives `&str` or `String`).
 fn panic_message(payload: &(dyn Any + Send)) -> String {
@@ -22,8 +74,14 @@ fn panic_message(payload: &(dyn Any + Send)) -> String {
 
 /// Record a caught panic and drop its payload without letting a second panic escape.
 fn record_panic(func: &str, payload: Box<dyn Any + Send>) {
+    let at = PANIC_AT
+        .try_with(|p| p.try_borrow_mut().ok().and_then(|mut p| p.take()))
+        .ok()
+        .flatten()
+        .map(|l| format!(" at {l}"))
+        .unwrap_or_default();
     set_last_error(&format!(
-        "{func}: internal error (panic): {}; please report this as a bug",
+        "{func}: internal error (panic{at}): {}; please report this as a bug",
         panic_message(&*payload)
     ));
     // A payload whose destructor panics must not unwind into C either.
@@ -54,7 +112,7 @@ pub(crate) fn status_call(
     func: &str,
     body: impl FnOnce() -> std::result::Result<(), Failure>,
 ) -> curvetet_status {
-    match catch_unwind(AssertUnwindSafe(body)) {
+    match in_call(body) {
         Ok(Ok(())) => {
             clear_last_error();
             curvetet_status::CURVETET_OK
@@ -74,7 +132,7 @@ pub(crate) fn status_call(
 /// error or a panic records the message and gives `fallback`; success leaves the last
 /// error as it was (so it can still be read after a failed call).
 pub(crate) fn value_call<T>(func: &str, fallback: T, body: impl FnOnce() -> Result<T>) -> T {
-    match catch_unwind(AssertUnwindSafe(body)) {
+    match in_call(body) {
         Ok(Ok(v)) => v,
         Ok(Err(e)) => {
             set_last_error(&format!("{func}: {e}"));
@@ -137,6 +195,38 @@ pub(crate) unsafe fn input_slice<'a, T>(p: *const T, len: usize, what: &str) -> 
     // SAFETY: non-NULL, aligned, size fits isize (checked); contents are the caller's
     // contract (documented in the header).
     Ok(unsafe { std::slice::from_raw_parts(p, len) })
+}
+
+/// Error unless `num_nodes` and `num_triangles` fit the library's 32-bit node indices
+/// (checked before any slice is made or memory is reserved from them).
+pub(crate) fn check_counts(num_nodes: usize, num_triangles: usize) -> Result<()> {
+    for (what, n) in [("num_nodes", num_nodes), ("num_triangles", num_triangles)] {
+        if n > u32::MAX as usize {
+            return Err(invalid(format!(
+                "{what} is {n}: at most {} (node indices are 32-bit)",
+                u32::MAX
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `src` copied into a new vector of `N`-element groups, or an error (not an abort) when
+/// the memory cannot be reserved.
+pub(crate) fn copy_groups<T: Copy + Default, const N: usize>(
+    src: &[T],
+    what: &str,
+) -> Result<Vec<[T; N]>> {
+    let n = src.len() / N;
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|e| invalid(format!("{what}: cannot reserve memory for {n} items ({e})")))?;
+    v.extend(src.chunks_exact(N).map(|c| {
+        let mut a = [T::default(); N];
+        a.copy_from_slice(c);
+        a
+    }));
+    Ok(v)
 }
 
 /// `n * k` elements, or an error when it overflows.

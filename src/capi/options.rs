@@ -49,6 +49,8 @@ pub struct curvetet_options {
     /// Worker threads for the parallel stages; 0 (default): one per CPU. The pool is
     /// created by each `curvetet_generate` call and gone when it returns; the front and
     /// the progress callback run on the calling thread. The result does not depend on it.
+    /// At most 4 per CPU and at most 1024: more is `CURVETET_ERR_INVALID_ARGUMENT`,
+    /// before any work.
     pub threads: u32,
     /// Progress callback; may be NULL (default).
     pub progress: curvetet_progress_fn,

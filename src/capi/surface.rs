@@ -1,7 +1,8 @@
 //! `curvetet_surface`: a checked, immutable P2 surface behind an opaque handle.
 
 use super::guard::{
-    check_ptr, copy_out, deref, input_slice, invalid, status_call, times, value_call,
+    check_counts, check_ptr, copy_groups, copy_out, deref, input_slice, invalid, status_call,
+    times, value_call,
 };
 use super::status::curvetet_status;
 use crate::{Result, Surface};
@@ -88,7 +89,8 @@ pub(crate) unsafe fn c_path(path: *const c_char) -> Result<PathBuf> {
 /// On success `*out` is a new surface the caller owns (free it with
 /// `curvetet_surface_free`). On failure `*out` is NULL and the status is
 /// `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, count
-/// overflow) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and
+/// overflow, a count above 4294967295 (node indices are 32-bit), or no memory for the
+/// copy: never an abort) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and
 /// the triangle, edge or node).
 ///
 /// # Safety
@@ -105,6 +107,7 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
     status_call("curvetet_surface_from_arrays", || {
         // SAFETY: `out` is the caller's; checked inside.
         unsafe { reset_out(out)? };
+        check_counts(num_nodes, num_triangles)?;
         let n3 = times(num_nodes, 3, "num_nodes")?;
         let t6 = times(num_triangles, 6, "num_triangles")?;
         // SAFETY: lengths as documented; NULL/alignment/size checked inside.
@@ -115,11 +118,8 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
             // SAFETY: as above.
             unsafe { input_slice(tags, num_triangles, "tags")? }.to_vec()
         };
-        let nodes: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let tris: Vec<[u32; 6]> = tri6
-            .chunks_exact(6)
-            .map(|c| std::array::from_fn(|k| c[k]))
-            .collect();
+        let nodes: Vec<[f64; 3]> = copy_groups(xyz, "xyz")?;
+        let tris: Vec<[u32; 6]> = copy_groups(tri6, "tri6")?;
         let s = Surface::new(nodes, tris, tags)?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };
@@ -140,8 +140,8 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
 ///
 /// On success `*out` is a new surface the caller owns (free it with
 /// `curvetet_surface_free`). On failure `*out` is NULL and the status is
-/// `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, bad
-/// angle) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and the
+/// `CURVETET_ERR_INVALID_ARGUMENT` (NULL `out`, NULL array with a nonzero count, a count
+/// above 4294967295, bad angle, more than 1000 smoothing iterations) or `CURVETET_ERR_INVALID_SURFACE` (the message names the failing check and the
 /// facet, edge or vertex).
 ///
 /// # Safety
@@ -228,6 +228,7 @@ unsafe fn from_linear_call(
     status_call(name, || {
         // SAFETY: `out` is the caller's; checked inside.
         unsafe { reset_out(out)? };
+        check_counts(num_nodes, num_triangles)?;
         let n3 = times(num_nodes, 3, "num_nodes")?;
         let t3 = times(num_triangles, 3, "num_triangles")?;
         // SAFETY: lengths as documented; NULL/alignment/size checked inside.
@@ -238,8 +239,8 @@ unsafe fn from_linear_call(
             // SAFETY: as above.
             unsafe { input_slice(tags, num_triangles, "tags")? }.to_vec()
         };
-        let nodes: Vec<[f64; 3]> = xyz.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        let tris: Vec<[u32; 3]> = tri3.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let nodes: Vec<[f64; 3]> = copy_groups(xyz, "xyz")?;
+        let tris: Vec<[u32; 3]> = copy_groups(tri3, "tri3")?;
         let opts = crate::surface::curve::CurveOptions {
             smooth_iterations,
             ..crate::surface::curve::CurveOptions::with_feature_angle(feature_angle_deg)

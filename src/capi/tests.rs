@@ -3,6 +3,7 @@
 
 use super::guard::{status_call, value_call};
 use super::options::{parse, MAX_STRUCT_SIZE};
+use super::surface::{curvetet_surface_from_linear, curvetet_surface_from_linear_smoothed};
 use super::*;
 use crate::{Error, SizeMode, SurfaceDefect};
 use std::ffi::{c_void, CStr, CString};
@@ -434,4 +435,167 @@ fn generate_through_the_abi() {
 
     unsafe { curvetet_mesh_free(m) };
     unsafe { curvetet_surface_free(s) };
+}
+
+#[test]
+fn impossible_counts_and_thread_counts_are_refused_at_once() {
+    use curvetet_status::*;
+    let t = std::time::Instant::now();
+    // 2^32 + 1 nodes: refused from the count alone, before the arrays are touched (so the
+    // small arrays here are never read past their end), instead of a 100 GB copy.
+    let xyz = [0.0f64; 3];
+    let tri = [0u32; 6];
+    let mut s: *mut curvetet_surface = null_mut();
+    let big = (1usize << 32) + 1;
+    let st =
+        unsafe { curvetet_surface_from_arrays(xyz.as_ptr(), big, tri.as_ptr(), 1, null(), &mut s) };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(s.is_null());
+    assert!(
+        last_error().contains("num_nodes is 4294967297"),
+        "{}",
+        last_error()
+    );
+    let st =
+        unsafe { curvetet_surface_from_arrays(xyz.as_ptr(), 1, tri.as_ptr(), big, null(), &mut s) };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(last_error().contains("num_triangles"), "{}", last_error());
+    let st = unsafe {
+        curvetet_surface_from_linear(xyz.as_ptr(), big, tri.as_ptr(), 1, null(), 40.0, &mut s)
+    };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    // Smoothing iterations above the cap.
+    let st = unsafe {
+        curvetet_surface_from_linear_smoothed(
+            xyz.as_ptr(),
+            1,
+            tri.as_ptr(),
+            1,
+            null(),
+            40.0,
+            u32::MAX,
+            &mut s,
+        )
+    };
+    assert_eq!(st, CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(last_error().contains("at most 1000"), "{}", last_error());
+
+    // 100,000 threads: refused before any thread starts.
+    let mut s = null_mut();
+    assert_eq!(
+        unsafe { curvetet_surface_read(sphere_path().as_ptr(), &mut s) },
+        CURVETET_OK
+    );
+    assert!(
+        t.elapsed() < std::time::Duration::from_secs(1),
+        "{:?}",
+        t.elapsed()
+    );
+    let t = std::time::Instant::now();
+    let mut o = curvetet_options::defaults();
+    o.threads = 100_000;
+    let mut m = null_mut();
+    assert_eq!(
+        unsafe { curvetet_generate(s, &o, &mut m) },
+        CURVETET_ERR_INVALID_ARGUMENT
+    );
+    assert!(m.is_null());
+    assert!(last_error().contains("100000 threads"), "{}", last_error());
+    assert!(
+        t.elapsed() < std::time::Duration::from_secs(1),
+        "{:?}",
+        t.elapsed()
+    );
+    unsafe { curvetet_surface_free(s) };
+}
+
+#[test]
+fn mesh_write_replaces_a_file_whole_and_reports_a_missing_directory() {
+    use curvetet_status::*;
+    let dir = std::env::temp_dir().join(format!("curvetet-capi-write-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut s = null_mut();
+    assert_eq!(
+        unsafe { curvetet_surface_read(sphere_path().as_ptr(), &mut s) },
+        CURVETET_OK
+    );
+    let mut o = curvetet_options::defaults();
+    o.optimize = 0;
+    let mut m = null_mut();
+    assert_eq!(unsafe { curvetet_generate(s, &o, &mut m) }, CURVETET_OK);
+    let out = dir.join("out.vtu");
+    std::fs::write(&out, vec![b'x'; 50 << 20]).unwrap(); // longer than the mesh
+    let c = CString::new(out.to_str().unwrap()).unwrap();
+    assert_eq!(unsafe { curvetet_mesh_write(m, c.as_ptr()) }, CURVETET_OK);
+    let bytes = std::fs::read(&out).unwrap();
+    let mesh = unsafe { &*m };
+    let expected = crate::io::mesh_to_bytes(
+        &mesh.generated.mesh,
+        crate::io::Format::Vtu,
+        &Default::default(),
+    )
+    .unwrap();
+    assert!(bytes == expected, "the file is not exactly the mesh");
+    let names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, ["out.vtu"], "a temporary file was left");
+    let missing = CString::new(dir.join("no/such/dir/out.msh").to_str().unwrap()).unwrap();
+    assert_eq!(
+        unsafe { curvetet_mesh_write(m, missing.as_ptr()) },
+        CURVETET_ERR_IO
+    );
+    assert!(
+        last_error().contains("no/such/dir/out.msh"),
+        "{}",
+        last_error()
+    );
+    unsafe {
+        curvetet_mesh_free(m);
+        curvetet_surface_free(s);
+    }
+}
+
+#[test]
+fn a_caught_panic_names_its_location_and_prints_nothing() {
+    if std::env::var_os("CURVETET_TEST_PANIC_CHILD").is_some() {
+        // In the child process: a panic inside an entry point, with stderr not captured.
+        let st = status_call("f", || panic!("quiet please"));
+        assert_eq!(st, curvetet_status::CURVETET_ERR_PANIC);
+        return;
+    }
+    let line = line!() + 1;
+    let st = status_call("f", || panic!("located"));
+    assert_eq!(st, curvetet_status::CURVETET_ERR_PANIC);
+    let msg = last_error();
+    assert!(
+        msg.contains(&format!("src/capi/tests.rs:{line}")) && msg.contains("located"),
+        "{msg}"
+    );
+    // The same test in a child process, whose stderr is not captured by the test
+    // harness: Rust's default hook would print "panicked at ... quiet please" there.
+    let o = std::process::Command::new(std::env::current_exe().unwrap())
+        .args([
+            "--exact",
+            "capi::tests::a_caught_panic_names_its_location_and_prints_nothing",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("CURVETET_TEST_PANIC_CHILD", "1")
+        .output()
+        .unwrap();
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(
+        o.status.success() && out.contains("1 passed"),
+        "{out}\n{err}"
+    );
+    assert!(
+        !err.contains("quiet please") && !out.contains("quiet please"),
+        "{err}"
+    );
 }

@@ -39,13 +39,14 @@
 //!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
 //!   instead (for meshio, MMG, TetGen, which do not read the P2 sections).
 
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::P3;
 use crate::mesh::TetMesh;
 
+mod atomic;
 mod cursor;
 mod linear;
 mod lines;
@@ -66,6 +67,7 @@ mod vtu;
 mod vtu_write;
 mod weld;
 
+pub use atomic::{check_output_dir, remove_unfinished_temporaries, same_file, write_atomic};
 pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
@@ -203,11 +205,50 @@ impl Format {
     }
 }
 
-/// Read a mesh file; the format comes from the extension.
+/// Read a mesh file; the format comes from the extension. Only a regular file (or a link
+/// to one) is read: a device such as `/dev/zero`, a FIFO or a directory is an
+/// [`Error::Io`] at once, and a file too large for the memory available is an error, not
+/// an abort.
 pub fn read(path: &Path) -> Result<RawMesh> {
     let format = Format::from_path(path)?;
-    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let bytes = read_regular_file(path)?;
     read_bytes(&bytes, format, &path.display().to_string())
+}
+
+/// The bytes of the regular file `path` (see [`read`]).
+fn read_regular_file(path: &Path) -> Result<Vec<u8>> {
+    use std::io::{Error as IoError, ErrorKind, Read};
+    // Checked before opening: opening a FIFO would wait for a writer.
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        let what = if meta.is_dir() {
+            "a directory"
+        } else {
+            "not a regular file (a device, FIFO or socket)"
+        };
+        return Err(Error::io(
+            path,
+            IoError::new(ErrorKind::InvalidInput, format!("{what}; give a mesh file")),
+        ));
+    }
+    let mut file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let len = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    let mut bytes = Vec::new();
+    usize::try_from(len)
+        .ok()
+        .and_then(|n| bytes.try_reserve_exact(n).ok())
+        .ok_or_else(|| {
+            Error::io(
+                path,
+                IoError::new(
+                    ErrorKind::OutOfMemory,
+                    format!("not enough memory to read this {len}-byte file"),
+                ),
+            )
+        })?;
+    file.read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    Ok(bytes)
 }
 
 /// Read a mesh held in memory; `name` is used in error locations. Never panics, whatever
@@ -321,7 +362,9 @@ fn write_view<W: Write>(
     }
 }
 
-fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result<()> {
+/// Can curvetet write `format` with `opts`? The writers check it too; this is for callers
+/// that want to refuse a bad request before any work (an error naming the problem).
+pub fn check_write_options(format: Format, opts: &WriteOptions) -> Result<()> {
     if !format.is_writable() {
         return Err(Error::InvalidArgument(format!(
             "cannot write the .{} extension: it is an input format for linear surfaces; write .msh, .vtu, .vtk or .mesh",
@@ -334,6 +377,11 @@ fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result
             format.extension()
         )));
     }
+    Ok(())
+}
+
+fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result<()> {
+    check_write_options(format, opts)?;
     let biggest = view.nodes.len().max(view.tri6.len() + view.tet10.len());
     if format == Format::Msh && opts.msh_version == MshVersion::V22 && biggest >= i32::MAX as usize
     {
@@ -348,11 +396,7 @@ fn write_file(path: &Path, view: &MeshView, opts: &WriteOptions) -> Result<()> {
     let format = Format::from_path(path)?;
     check_options(format, opts, view)?;
     view.validate()?;
-    let file = std::fs::File::create(path).map_err(|e| Error::io(path, e))?;
-    let mut w = BufWriter::with_capacity(1 << 20, file);
-    write_view(&mut w, format, view, opts).map_err(|e| Error::io(path, e))?;
-    w.flush().map_err(|e| Error::io(path, e))?;
-    Ok(())
+    write_atomic(path, |w| write_view(w, format, view, opts))
 }
 
 /// Write a P2 tetrahedral mesh and its boundary triangles; the format comes from the

@@ -18,6 +18,11 @@ use super::vtk_cells::{self, add_cell, tag_rank};
 use super::RawMesh;
 use crate::error::{Error, Result};
 
+/// The deepest nesting of XML elements read. A VTU file nests about six deep (VTKFile,
+/// UnstructuredGrid, Piece, Points, DataArray, InformationKey); the bound keeps a file of
+/// millions of unclosed tags from holding millions of open element names.
+const MAX_DEPTH: usize = 64;
+
 /// Element types of data arrays.
 #[derive(Clone, Copy, PartialEq)]
 enum NumType {
@@ -176,6 +181,12 @@ impl<'a> Vtu<'a> {
                     if name == b"AppendedData" {
                         // Everything we read precedes it; its raw bytes are not XML.
                         break;
+                    }
+                    if path.len() >= MAX_DEPTH {
+                        return Err(self.err(
+                            before,
+                            format!("elements nested more than {MAX_DEPTH} deep"),
+                        ));
                     }
                     self.open(&e, &path, before)?;
                     path.push(name);

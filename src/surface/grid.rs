@@ -1,12 +1,20 @@
-//! A uniform grid over axis-aligned boxes: the broad phase of the intersection checks
-//! and of the ray queries of the nesting test.
+//! The broad phase of the intersection checks and of the ray queries of the nesting
+//! test: uniform grids over axis-aligned boxes, one per size level.
 //!
-//! Sparse: each (cell, box) registration is a sorted `(key, id)` pair, so memory follows
-//! the registrations, not the grid's volume. The cell size starts at the mean box size and
-//! doubles while the registrations would exceed 8 per box (a few huge triangles cannot
-//! blow it up). Each overlapping pair is reported once: in the cell holding the minimum
-//! corner of the two boxes' intersection. Keys are ordered (y, z, x) so that a row of
-//! cells along +x is one contiguous key range.
+//! Levels: the boxes are grouped by size, each level holding boxes within a factor
+//! [`LEVEL_RATIO`] of each other, and each level gets its own uniform grid sized for its
+//! boxes. One grid for all would size its cells for the mean box: a few huge triangles
+//! around many tiny ones (a small dense sphere inside a large cube) then make cells so
+//! large that every tiny triangle shares one cell, and the pairs grow quadratically.
+//! Pairs within a level come from its grid; a box of a smaller level finds its partners in
+//! each larger level's grid, whose cells are at least its size, so it looks at a few cells.
+//!
+//! Each uniform grid is sparse: each (cell, box) registration is a sorted `(key, id)`
+//! pair, so memory follows the registrations, not the grid's volume. The cell size starts
+//! at the mean box size and doubles while the registrations would exceed 8 per box. Each
+//! overlapping pair is reported once: in the cell holding the minimum corner of the two
+//! boxes' intersection. Keys are ordered (y, z, x) so that a row of cells along +x is one
+//! contiguous key range.
 
 use rayon::prelude::*;
 
@@ -18,8 +26,8 @@ pub(crate) type Aabb = [P3; 2];
 /// Most cells per axis (keys pack 3 x 21 bits).
 const MAX_DIM: u64 = 1 << 20;
 
-/// The grid (see the module docs).
-pub(crate) struct Grid {
+/// One level's uniform grid (see the module docs).
+struct Uniform {
     origin: P3,
     inv_h: f64,
     dims: [u64; 3],
@@ -51,7 +59,7 @@ pub(crate) fn bbox<const N: usize>(p: [P3; N]) -> Aabb {
     [lo, hi]
 }
 
-impl Grid {
+impl Uniform {
     #[inline]
     fn idx(&self, v: f64, d: usize) -> u64 {
         let f = ((v - self.origin[d]) * self.inv_h).floor();
@@ -68,8 +76,8 @@ impl Grid {
     }
 
     /// Builds the grid over `boxes` (finite coordinates).
-    pub fn build(boxes: &[Aabb]) -> Grid {
-        let mut g = Grid {
+    fn build(boxes: &[Aabb]) -> Uniform {
+        let mut g = Uniform {
             origin: [0.0; 3],
             inv_h: 1.0,
             dims: [1; 3],
@@ -132,7 +140,7 @@ impl Grid {
             for iy in l[1]..=u[1] {
                 for iz in l[2]..=u[2] {
                     for ix in l[0]..=u[0] {
-                        reg.push((Grid::key(ix, iy, iz), id as u32));
+                        reg.push((Uniform::key(ix, iy, iz), id as u32));
                     }
                 }
             }
@@ -164,7 +172,7 @@ impl Grid {
     /// worker folds its pairs into a state made by `init` with `visit`, and the states are
     /// merged with `merge`. With an order-independent `merge` (e.g. a minimum) the result
     /// does not depend on the thread count.
-    pub fn fold_pairs<T, I, V, M>(&self, boxes: &[Aabb], init: I, visit: V, merge: M) -> T
+    fn fold_pairs<T, I, V, M>(&self, boxes: &[Aabb], init: I, visit: V, merge: M) -> T
     where
         T: Send,
         I: Fn() -> T + Sync + Send,
@@ -196,14 +204,45 @@ impl Grid {
             .reduce(&init, merge)
     }
 
+    /// Calls `f` with the id of every box of this grid that overlaps `q`, each once (in
+    /// the cell of the intersection's min corner, as in [`Uniform::fold_pairs`]).
+    fn overlapping(&self, boxes: &[Aabb], q: &Aabb, mut f: impl FnMut(u32)) {
+        if self.cells.is_empty() {
+            return;
+        }
+        let (l, u, _) = self.span(q);
+        for iy in l[1]..=u[1] {
+            for iz in l[2]..=u[2] {
+                let k0 = Uniform::key(l[0], iy, iz);
+                let start = self.cells.partition_point(|c| c.0 < k0);
+                for &(key, s, e) in &self.cells[start..] {
+                    let ix = key & 0x1f_ffff;
+                    if key > Uniform::key(u[0], iy, iz) {
+                        break;
+                    }
+                    let cell = [ix, iy, iz];
+                    for &id in &self.items[s as usize..e as usize] {
+                        let b = &boxes[id as usize];
+                        if !overlap(q, b) {
+                            continue;
+                        }
+                        let lb = self.lo[id as usize];
+                        if (0..3).all(|d| l[d].max(lb[d] as u64) == cell[d]) {
+                            f(id);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Ids of the boxes that may meet the ray from `p` along +x: those registered in the
     /// row of cells through `p` from `p`'s cell on, each once. Every box whose closed
     /// (y, z) extent contains `p`'s (y, z) and whose max x >= `p.x` is among them.
-    pub fn ray_x(&self, boxes: &[Aabb], p: P3, out: &mut Vec<u32>) {
-        out.clear();
+    fn ray_x(&self, boxes: &[Aabb], p: P3, out: &mut Vec<u32>) {
         let (ix, iy, iz) = (self.idx(p[0], 0), self.idx(p[1], 1), self.idx(p[2], 2));
-        let k0 = Grid::key(ix, iy, iz);
-        let k1 = Grid::key(self.dims[0] - 1, iy, iz);
+        let k0 = Uniform::key(ix, iy, iz);
+        let k1 = Uniform::key(self.dims[0] - 1, iy, iz);
         let start = self.cells.partition_point(|c| c.0 < k0);
         for &(key, s, e) in &self.cells[start..] {
             if key > k1 {
@@ -217,5 +256,264 @@ impl Grid {
                 }
             }
         }
+    }
+}
+
+/// Box sizes within one level differ by at most this factor.
+const LEVEL_RATIO: f64 = 8.0;
+
+/// One size level: its boxes (copies, in level order), their ids in the caller's slice
+/// (`None`: the identity, when there is a single level), and its grid.
+struct Level {
+    boxes: Vec<Aabb>,
+    ids: Option<Vec<u32>>,
+    grid: Uniform,
+}
+
+impl Level {
+    #[inline]
+    fn id(&self, local: u32) -> u32 {
+        self.ids.as_ref().map_or(local, |v| v[local as usize])
+    }
+}
+
+/// The broad phase over boxes of any mix of sizes (see the module docs).
+pub(crate) struct Grid {
+    /// Levels by increasing box size; empty levels are left out.
+    levels: Vec<Level>,
+}
+
+/// The largest extent of a box over the three axes.
+fn extent(b: &Aabb) -> f64 {
+    (0..3).map(|d| b[1][d] - b[0][d]).fold(0.0, f64::max)
+}
+
+impl Grid {
+    /// Builds the levels and their grids over `boxes` (finite coordinates).
+    pub fn build(boxes: &[Aabb]) -> Grid {
+        let smallest = boxes
+            .iter()
+            .map(extent)
+            .filter(|&e| e > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let level_of = |b: &Aabb| -> usize {
+            let r = extent(b) / smallest;
+            if r.is_finite() && r > 1.0 {
+                (r.log2() / LEVEL_RATIO.log2()).floor().min(63.0) as usize
+            } else {
+                0
+            }
+        };
+        let mut members: Vec<Vec<u32>> = Vec::new();
+        for (i, b) in boxes.iter().enumerate() {
+            let l = level_of(b);
+            if members.len() <= l {
+                members.resize_with(l + 1, Vec::new);
+            }
+            members[l].push(i as u32);
+        }
+        members.retain(|m| !m.is_empty());
+        if members.len() <= 1 {
+            return Grid {
+                levels: vec![Level {
+                    boxes: Vec::new(),
+                    ids: None,
+                    grid: Uniform::build(boxes),
+                }],
+            };
+        }
+        let levels = members
+            .into_iter()
+            .map(|ids| {
+                let level_boxes: Vec<Aabb> = ids.iter().map(|&i| boxes[i as usize]).collect();
+                Level {
+                    grid: Uniform::build(&level_boxes),
+                    boxes: level_boxes,
+                    ids: Some(ids),
+                }
+            })
+            .collect();
+        Grid { levels }
+    }
+
+    /// The boxes of a level: the caller's for the single level, else the level's copies.
+    fn boxes_of<'a>(&'a self, level: &'a Level, boxes: &'a [Aabb]) -> &'a [Aabb] {
+        if level.ids.is_none() {
+            boxes
+        } else {
+            &level.boxes
+        }
+    }
+
+    /// Visits every pair (i < j) of overlapping boxes exactly once, in parallel: each
+    /// worker folds its pairs into a state made by `init` with `visit`, and the states are
+    /// merged with `merge`. With an order-independent `merge` (e.g. a minimum) the result
+    /// does not depend on the thread count.
+    pub fn fold_pairs<T, I, V, M>(&self, boxes: &[Aabb], init: I, visit: V, merge: M) -> T
+    where
+        T: Send,
+        I: Fn() -> T + Sync + Send,
+        V: Fn(&mut T, u32, u32) + Sync + Send,
+        M: Fn(T, T) -> T + Sync + Send,
+    {
+        let ordered = |t: &mut T, a: u32, b: u32| visit(t, a.min(b), a.max(b));
+        let mut acc = init();
+        for (k, level) in self.levels.iter().enumerate() {
+            let own = self.boxes_of(level, boxes);
+            let within = level.grid.fold_pairs(
+                own,
+                &init,
+                |t, a, b| ordered(t, level.id(a), level.id(b)),
+                &merge,
+            );
+            acc = merge(acc, within);
+            // This level's boxes against every larger level's grid.
+            for larger in &self.levels[k + 1..] {
+                let theirs = self.boxes_of(larger, boxes);
+                let across = own
+                    .par_iter()
+                    .enumerate()
+                    .fold(&init, |mut t, (a, q)| {
+                        let a = level.id(a as u32);
+                        larger
+                            .grid
+                            .overlapping(theirs, q, |b| ordered(&mut t, a, larger.id(b)));
+                        t
+                    })
+                    .reduce(&init, &merge);
+                acc = merge(acc, across);
+            }
+        }
+        acc
+    }
+
+    /// Ids of the boxes that may meet the ray from `p` along +x: every box whose closed
+    /// (y, z) extent contains `p`'s (y, z) and whose max x >= `p.x` is among them, each
+    /// once (and a few others).
+    pub fn ray_x(&self, boxes: &[Aabb], p: P3, out: &mut Vec<u32>) {
+        out.clear();
+        let mut local = Vec::new();
+        for level in &self.levels {
+            if level.ids.is_none() {
+                level.grid.ray_x(boxes, p, out);
+                continue;
+            }
+            local.clear();
+            level.grid.ray_x(&level.boxes, p, &mut local);
+            out.extend(local.iter().map(|&i| level.id(i)));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every overlapping pair, by brute force.
+    fn brute(boxes: &[Aabb]) -> Vec<(u32, u32)> {
+        let mut v = Vec::new();
+        for i in 0..boxes.len() {
+            for j in i + 1..boxes.len() {
+                if overlap(&boxes[i], &boxes[j]) {
+                    v.push((i as u32, j as u32));
+                }
+            }
+        }
+        v
+    }
+
+    fn pairs(boxes: &[Aabb]) -> Vec<(u32, u32)> {
+        let g = Grid::build(boxes);
+        let mut v = g.fold_pairs(
+            boxes,
+            Vec::new,
+            |v: &mut Vec<(u32, u32)>, a, b| v.push((a, b)),
+            |mut a, b| {
+                a.extend(b);
+                a
+            },
+        );
+        v.sort_unstable();
+        v
+    }
+
+    /// A deterministic pseudo-random sequence in [0, 1).
+    fn lcg(state: &mut u64) -> f64 {
+        *state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn pairs_on_mixed_scales_are_exactly_the_overlapping_ones_once() {
+        let mut st = 7;
+        let mut boxes = Vec::new();
+        // Boxes of sizes from 1e-4 to 1e3 around the origin, and some flat ones.
+        for k in 0..600 {
+            let size = 10f64.powf(-4.0 + 7.0 * lcg(&mut st));
+            let c = [0, 1, 2].map(|_| (lcg(&mut st) - 0.5) * 2.0 * size.max(1.0));
+            let mut h = [size / 2.0; 3];
+            if k % 7 == 0 {
+                h[k % 3] = 0.0;
+            }
+            boxes.push([
+                [c[0] - h[0], c[1] - h[1], c[2] - h[2]],
+                [c[0] + h[0], c[1] + h[1], c[2] + h[2]],
+            ]);
+        }
+        let got = pairs(&boxes);
+        assert_eq!(got, brute(&boxes));
+        assert!(got.len() > 1000, "{}", got.len());
+        // The ray query finds every box the ray can meet, each once, through the levels.
+        let g = Grid::build(&boxes);
+        let mut out = Vec::new();
+        for _ in 0..50 {
+            let p = [0, 1, 2].map(|_| (lcg(&mut st) - 0.5) * 2.0);
+            g.ray_x(&boxes, p, &mut out);
+            let mut sorted = out.clone();
+            sorted.sort_unstable();
+            sorted.dedup();
+            assert_eq!(sorted.len(), out.len(), "a box reported twice");
+            for (i, b) in boxes.iter().enumerate() {
+                let hit = (1..3).all(|d| b[0][d] <= p[d] && p[d] <= b[1][d]) && b[1][0] >= p[0];
+                assert!(!hit || out.contains(&(i as u32)), "box {i} missed");
+            }
+        }
+    }
+
+    #[test]
+    fn tiny_boxes_beside_huge_ones_do_not_share_one_cell() {
+        // 5,000 tiny boxes in a ball of radius 1e-3 and 12 boxes of the faces of a cube
+        // of side 1000: with one uniform grid the huge boxes made the cells so large that
+        // all tiny boxes shared one (12.5 million candidate pairs); by level, the tiny
+        // ones get their own grid.
+        let mut st = 3;
+        let mut boxes = Vec::new();
+        for _ in 0..5_000 {
+            let c = [0, 1, 2].map(|_| (lcg(&mut st) - 0.5) * 2e-3);
+            let h = 2e-5;
+            boxes.push([c.map(|x| x - h), c.map(|x| x + h)]);
+        }
+        for d in 0..3 {
+            for side in [-500.0, 500.0] {
+                for _ in 0..2 {
+                    let mut lo = [-500.0; 3];
+                    let mut hi = [500.0; 3];
+                    lo[d] = side;
+                    hi[d] = side;
+                    boxes.push([lo, hi]);
+                }
+            }
+        }
+        let g = Grid::build(&boxes);
+        let candidates: u64 = g
+            .levels
+            .iter()
+            .flat_map(|l| &l.grid.cells)
+            .map(|&(_, s, e)| ((e - s) as u64).pow(2) / 2)
+            .sum();
+        assert!(candidates < 200_000, "{candidates} candidate pairs");
+        assert_eq!(pairs(&boxes), brute(&boxes));
     }
 }

@@ -113,6 +113,11 @@ pub struct CurveOptions {
     pub smooth_iterations: u32,
 }
 
+/// The most smoothing iterations [`CurveOptions::smooth_iterations`] accepts: each one
+/// shrinks the surface a little, and far fewer (10) already make marching-cubes
+/// triangles well shaped; a larger count is a mistake that would run for hours.
+pub const MAX_SMOOTH_ITERATIONS: u32 = 1000;
+
 impl Default for CurveOptions {
     fn default() -> Self {
         CurveOptions {
@@ -134,7 +139,16 @@ impl CurveOptions {
         }
     }
 
-    fn validate(&self) -> Result<()> {
+    /// Check every option; a bad one is an [`Error::InvalidArgument`] naming it. Callers
+    /// that read a file first (the command-line tool) call it before reading.
+    pub fn validate(&self) -> Result<()> {
+        if self.smooth_iterations > MAX_SMOOTH_ITERATIONS {
+            return Err(Error::InvalidArgument(format!(
+                "{} smoothing iterations: at most {MAX_SMOOTH_ITERATIONS} (10 is enough for \
+                 marching-cubes surfaces)",
+                self.smooth_iterations
+            )));
+        }
         if !(0.0..=180.0).contains(&self.feature_angle_deg) {
             return Err(Error::InvalidArgument(format!(
                 "feature angle {} degrees: must be within 0..=180",
