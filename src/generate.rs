@@ -183,6 +183,7 @@ fn generate_inner(
             surface.triangles(),
             surface.tags(),
         );
+        mesh.groups = surface.groups().clone();
         times.assemble += t.elapsed().as_secs_f64();
 
         if opts.optimize {

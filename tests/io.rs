@@ -127,6 +127,7 @@ fn curved_mesh() -> TetMesh {
         tets,
         boundary,
         boundary_tags: vec![4, 7, 4, 2, 7, 9],
+        groups: Default::default(),
     }
 }
 
@@ -334,25 +335,37 @@ fn round_trip_surface_only() {
     }
 }
 
+/// Every boundary part is a group with a positive number in every format (issue 30):
+/// positive tags are kept, 0 and then -3 take the first free numbers, 1 and 2.
 #[test]
-fn non_positive_tags_get_their_own_msh_entities() {
+fn non_positive_tags_get_free_positive_groups() {
     let mut mesh = curved_mesh();
     mesh.boundary_tags = vec![0, 5, -3, 5, 0, 5];
+    let want = vec![1, 5, 2, 5, 1, 5];
     for ver in [MshVersion::V41, MshVersion::V22] {
-        let opts = WriteOptions {
-            msh_version: ver,
-            ..Default::default()
-        };
-        let bytes = mesh_to_bytes(&mesh, Format::Msh, &opts).unwrap();
-        let back = read_bytes(&bytes, Format::Msh, "t.msh").unwrap();
-        // Positive tags survive; 0 and -3 become fresh entity tags 6 and 7 (sorted).
-        assert_eq!(back.tri6_tags, vec![7, 5, 6, 5, 7, 5], "{ver:?}");
+        for binary in [false, true] {
+            let opts = WriteOptions {
+                msh_version: ver,
+                binary,
+                ..Default::default()
+            };
+            let bytes = mesh_to_bytes(&mesh, Format::Msh, &opts).unwrap();
+            let back = read_bytes(&bytes, Format::Msh, "t.msh").unwrap();
+            assert_eq!(back.tri6_tags, want, "{ver:?} binary {binary}");
+            // Tag 0 is the group named `boundary`, the volume `volume`.
+            let names: Vec<_> = back
+                .physical_names
+                .iter()
+                .map(|n| (n.dim, n.tag, n.name.as_str()))
+                .collect();
+            assert_eq!(names, vec![(2, 1, "boundary"), (3, 1, "volume")]);
+            assert!(back.tet10_tags.iter().all(|&t| t == 1));
+        }
     }
-    // VTK and medit keep any tag.
     for f in [Format::Vtu, Format::Vtk, Format::Medit] {
         let bytes = mesh_to_bytes(&mesh, f, &WriteOptions::default()).unwrap();
         let back = read_bytes(&bytes, f, "t").unwrap();
-        assert_eq!(back.tri6_tags, mesh.boundary_tags, "{f:?}");
+        assert_eq!(back.tri6_tags, want, "{f:?}");
     }
 }
 

@@ -96,6 +96,7 @@ fn small_mesh() -> TetMesh {
             [1, 2, 3, 5, 8, 9],
         ],
         boundary_tags: vec![1, 2, 3, 3],
+        groups: Default::default(),
     }
 }
 
@@ -114,6 +115,7 @@ fn written_files() -> Vec<(String, Format, Vec<u8>, usize)> {
         tets: vec![],
         boundary: s.tri6,
         boundary_tags: s.tri6_tags,
+        groups: Default::default(),
     };
     let mut out = Vec::new();
     for (mname, m) in [("tet", &mesh), ("sphere", &big)] {

@@ -424,7 +424,9 @@ fn curve_raw(raw: io::RawMesh, name: &str, c: &CurveArgs) -> Result<(Surface, Cu
         return io::surface_from_raw_any(raw, name, &c.options())
             .map(|s| (s, CurveReport::default()));
     }
-    curve_linear_report(raw.nodes, raw.tri3, raw.tri3_tags, &c.options())
+    let groups = raw.groups();
+    let (s, r) = curve_linear_report(raw.nodes, raw.tri3, raw.tri3_tags, &c.options())?;
+    Ok((s.with_groups(groups), r))
 }
 
 fn curve_summary(name: &str, s: &Surface, r: &CurveReport) -> String {

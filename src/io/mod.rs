@@ -47,6 +47,7 @@ use crate::geom::P3;
 use crate::mesh::TetMesh;
 
 mod cursor;
+mod groups;
 mod linear;
 mod lines;
 mod medit;
@@ -66,6 +67,7 @@ mod vtu;
 mod vtu_write;
 mod weld;
 
+pub use groups::{Groups, PhysicalName, DEFAULT_VOLUME_NAME, UNTAGGED_BOUNDARY_NAME};
 pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
@@ -100,9 +102,33 @@ pub struct RawMesh {
     pub tet10_tags: Vec<i32>,
     /// Elements of other kinds (points, lines, quads, ...) that were skipped.
     pub ignored_elements: u64,
+    /// Named physical groups (Gmsh `$PhysicalNames`), in file order.
+    pub physical_names: Vec<PhysicalName>,
 }
 
 impl RawMesh {
+    /// The volume's tag and the group names: the tag of the first 10-node (else 4-node)
+    /// tetrahedron when positive; without tetrahedra, the only named volume group if
+    /// there is exactly one; else [`VOLUME_TAG`].
+    pub fn groups(&self) -> Groups {
+        let from_tets = self
+            .tet10_tags
+            .first()
+            .or(self.tet4_tags.first())
+            .copied()
+            .filter(|&t| t > 0);
+        let mut volumes = self.physical_names.iter().filter(|n| n.dim == 3);
+        let named = match (volumes.next(), volumes.next()) {
+            (Some(n), None) if n.tag > 0 => Some(n.tag),
+            _ => None,
+        };
+        let tets = !self.tet10_tags.is_empty() || !self.tet4_tags.is_empty();
+        Groups {
+            volume_tag: if tets { from_tets } else { named }.unwrap_or(VOLUME_TAG),
+            names: self.physical_names.clone(),
+        }
+    }
+
     /// The P2 mesh in it: nodes, 10-node tets and 6-node boundary triangles with tags.
     ///
     /// A file with only 3-node triangles is a linear surface:
@@ -124,11 +150,13 @@ impl RawMesh {
                 self.tet4.len()
             )));
         }
+        let groups = self.groups();
         Ok(TetMesh {
             nodes: self.nodes,
             tets: self.tet10,
             boundary: self.tri6,
             boundary_tags: self.tri6_tags,
+            groups,
         })
     }
 }
@@ -269,6 +297,7 @@ pub(crate) struct MeshView<'a> {
     pub tri6: &'a [[u32; 6]],
     pub tags: &'a [i32],
     pub tet10: &'a [[u32; 10]],
+    pub groups: &'a Groups,
 }
 
 impl MeshView<'_> {
@@ -308,11 +337,24 @@ fn write_view<W: Write>(
     view: &MeshView,
     opts: &WriteOptions,
 ) -> std::io::Result<()> {
+    // .msh writes the groups itself (entities, names); the others write each triangle's
+    // physical tag (untagged triangles: the `boundary` group's number, not 0).
+    let has_volume = !view.tet10.is_empty() || view.tri6.is_empty();
+    let groups = groups::Resolved::new(view.tags, view.groups, has_volume);
+    let tags = if format == Format::Msh {
+        Vec::new()
+    } else {
+        groups.triangle_tags(view.tags)
+    };
+    let resolved = MeshView {
+        tags: &tags,
+        ..*view
+    };
     match format {
         Format::Msh => msh_write::write(w, view, opts),
-        Format::Vtu => vtu_write::write(w, view, opts.binary),
-        Format::Vtk => vtk::write(w, view),
-        Format::Medit => medit::write(w, view, opts.medit_linear),
+        Format::Vtu => vtu_write::write(w, &resolved, opts.binary),
+        Format::Vtk => vtk::write(w, &resolved),
+        Format::Medit => medit::write(w, &resolved, groups.volume, opts.medit_linear),
         // Refused by `check_options` before any byte is written.
         Format::Stl | Format::Off | Format::Obj | Format::Ply => Err(std::io::Error::new(
             std::io::ErrorKind::Unsupported,
@@ -363,6 +405,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, opts: &WriteOptions) -> Result<()
         tri6: &mesh.boundary,
         tags: &mesh.boundary_tags,
         tet10: &mesh.tets,
+        groups: &mesh.groups,
     };
     write_file(path, &view, opts)
 }
@@ -381,6 +424,7 @@ pub fn write_surface(
         tri6,
         tags,
         tet10: &[],
+        groups: &Groups::default(),
     };
     write_file(path, &view, opts)
 }
@@ -392,6 +436,7 @@ pub fn mesh_to_bytes(mesh: &TetMesh, format: Format, opts: &WriteOptions) -> Res
         tri6: &mesh.boundary,
         tags: &mesh.boundary_tags,
         tet10: &mesh.tets,
+        groups: &mesh.groups,
     };
     check_options(format, opts, &view)?;
     view.validate()?;
