@@ -308,3 +308,200 @@ fn mesh_plots_the_two_histograms_and_optimization_can_be_turned_off() {
     assert!(skew(&opt) < skew(&raw), "{} vs {}", skew(&opt), skew(&raw));
     assert!(sj(&opt) >= 0.8 && skew(&opt) <= 0.85);
 }
+
+/// Checks each file of a JSON list with meshio: it reads without warning, holds P2 tets
+/// and triangles, the triangles' and tets' tags (cell array `key`) are the given sets, and
+/// for .msh files the physical names are the given (name, tag, dim) triples.
+const MESHIO_GROUPS: &str = r#"
+import json, sys, warnings
+import numpy as np
+import meshio
+spec = json.loads(sys.argv[1])
+for f in spec:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = meshio.read(f["path"])
+    kinds = sorted({b.type for b in m.cells})
+    assert kinds == ["tetra10", "triangle6"], (f["path"], kinds)
+    tri, tet = set(), set()
+    for b, d in zip(m.cells, m.cell_data[f["key"]]):
+        vals = {int(x) for x in np.asarray(d).reshape(-1)}
+        (tri if b.type == "triangle6" else tet).update(vals)
+    assert sorted(tri) == f["tri"], (f["path"], sorted(tri), f["tri"])
+    assert sorted(tet) == f["tet"], (f["path"], sorted(tet), f["tet"])
+    if "names" in f:
+        got = sorted([k, int(v[0]), int(v[1])] for k, v in m.field_data.items())
+        assert got == sorted(f["names"]), (f["path"], got, f["names"])
+print("meshio ok", len(spec))
+"#;
+
+/// A P2 sphere whose triangles are tagged 3 (z > 0, "inlet") and 7 ("wall"), in a
+/// volume named "fluid" with tag 4: an MSH 2.2 file as Gmsh writes one with named
+/// physical groups.
+fn named_sphere(path: &Path) {
+    use curvetet::io;
+    let raw = io::read(&data("sphere_p2.msh")).unwrap();
+    let tags: Vec<i32> = raw
+        .tri6
+        .iter()
+        .map(|t| {
+            let z: f64 = t[..3].iter().map(|&v| raw.nodes[v as usize][2]).sum();
+            if z > 0.0 {
+                3
+            } else {
+                7
+            }
+        })
+        .collect();
+    let opts = io::WriteOptions {
+        msh_version: io::MshVersion::V22,
+        ..Default::default()
+    };
+    io::write_surface(path, &raw.nodes, &raw.tri6, &tags, &opts).unwrap();
+    let text = std::fs::read_to_string(path).unwrap();
+    // The writer names nothing on a surface of tagged triangles: add the names.
+    assert!(!text.contains("$PhysicalNames"));
+    let names =
+        "$PhysicalNames\n3\n2 3 \"inlet\"\n2 7 \"wall\"\n3 4 \"fluid\"\n$EndPhysicalNames\n";
+    let text = text.replacen("$EndMeshFormat\n", &format!("$EndMeshFormat\n{names}"), 1);
+    std::fs::write(path, text).unwrap();
+}
+
+/// Issue 30: every output of a tagged-and-named input and of an untagged one, in every
+/// format and encoding, is read by meshio without warning, with a physical group for each
+/// boundary part and for the volume: the input's numbers and names, or `boundary` 1 and
+/// `volume` 1. curvetet reads the same numbers and names back, and Gmsh opens the .msh
+/// files without a warning.
+#[test]
+fn groups_survive_every_output_format() {
+    let named = tmp("named_sphere.msh");
+    named_sphere(&named);
+    type Case = (
+        &'static str,
+        PathBuf,
+        Vec<i32>,
+        i32,
+        Vec<(&'static str, i32, u8)>,
+    );
+    let cases: Vec<Case> = vec![
+        (
+            "named",
+            named,
+            vec![3, 7],
+            4,
+            vec![("inlet", 3, 2), ("wall", 7, 2), ("fluid", 4, 3)],
+        ),
+        (
+            "untagged",
+            data("sphere_lin.off"),
+            vec![1],
+            1,
+            vec![("boundary", 1, 2), ("volume", 1, 3)],
+        ),
+    ];
+    let gmsh = Command::new("gmsh").arg("-version").output().is_ok();
+    let mut spec = Vec::new();
+    for (name, input, tri, vol, names) in &cases {
+        let first = tmp(&format!("groups_{name}.msh"));
+        let out = run(&[
+            "mesh",
+            input.to_str().unwrap(),
+            "-o",
+            first.to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let variants: [(&str, &[&str]); 7] = [
+            ("41.msh", &[]),
+            ("41b.msh", &["--binary"]),
+            ("22.msh", &["--msh22"]),
+            ("22b.msh", &["--msh22", "--binary"]),
+            ("a.vtu", &[]),
+            ("b.vtu", &["--binary"]),
+            ("a.vtk", &[]),
+        ];
+        for (suffix, flags) in variants {
+            let path = tmp(&format!("groups_{name}_{suffix}"));
+            let mut args = vec!["convert", first.to_str().unwrap(), path.to_str().unwrap()];
+            args.extend_from_slice(flags);
+            let out = run(&args);
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let msh = suffix.ends_with(".msh");
+            // curvetet reads back the input's numbers (and, from .msh, names).
+            let back = curvetet::io::read(&path).unwrap();
+            let mut got: Vec<i32> = back.tri6_tags.clone();
+            got.sort_unstable();
+            got.dedup();
+            assert_eq!(&got, tri, "{name} {suffix}");
+            if msh {
+                assert!(back.tet10_tags.iter().all(|t| t == vol), "{name} {suffix}");
+                let mut got: Vec<(String, i32, u8)> = back
+                    .physical_names
+                    .iter()
+                    .map(|n| (n.name.clone(), n.tag, n.dim))
+                    .collect();
+                got.sort();
+                let mut want: Vec<(String, i32, u8)> = names
+                    .iter()
+                    .map(|&(n, t, d)| (n.to_string(), t, d))
+                    .collect();
+                want.sort();
+                assert_eq!(got, want, "{name} {suffix}");
+                if gmsh {
+                    let o = Command::new("gmsh")
+                        .args([path.to_str().unwrap(), "-0", "-o"])
+                        .arg(tmp(&format!("groups_{name}_{suffix}_gmsh.msh")))
+                        .output()
+                        .unwrap();
+                    let text = String::from_utf8_lossy(&o.stdout).to_string()
+                        + &String::from_utf8_lossy(&o.stderr);
+                    assert!(o.status.success(), "gmsh {name} {suffix}: {text}");
+                    assert!(
+                        !text.contains("Warning") && !text.contains("Error"),
+                        "gmsh {name} {suffix}: {text}"
+                    );
+                }
+            }
+            let mut entry = serde_json::json!({
+                "path": path.to_str().unwrap(),
+                "key": if msh { "gmsh:physical" } else { "BoundaryTag" },
+                "tri": tri,
+                "tet": if msh { vec![*vol] } else { vec![0] },
+            });
+            if msh {
+                entry["names"] = serde_json::json!(names
+                    .iter()
+                    .map(|&(n, t, d)| serde_json::json!([n, t, d]))
+                    .collect::<Vec<_>>());
+            }
+            spec.push(entry);
+        }
+    }
+    let out = Command::new("python3")
+        .args([
+            "-c",
+            MESHIO_GROUPS,
+            &serde_json::Value::from(spec).to_string(),
+        ])
+        .output()
+        .expect("python3 runs (scripts/install-deps installs meshio)");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "meshio failed:\n{text}");
+    assert!(text.contains("meshio ok 14"), "{text}");
+    assert!(
+        !text.to_lowercase().contains("warn"),
+        "meshio warned:\n{text}"
+    );
+}
