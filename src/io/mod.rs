@@ -4,8 +4,8 @@
 //! | format | read | write |
 //! |---|---|---|
 //! | `.msh` | 2.2 (also 2.0/2.1) and 4.1, ASCII and binary, either endianness | 4.1 (default) or 2.2, ASCII (default) or binary |
-//! | `.vtu` | ASCII and inline base64 `binary` arrays (UInt32/UInt64 header, uncompressed) | ASCII (default) or inline base64 binary |
-//! | `.vtk` | legacy ASCII `UNSTRUCTURED_GRID`, classic and 5.x `CELLS` layouts | legacy ASCII (version 4.2 layout) |
+//! | `.vtu` | ASCII, inline base64 `binary` and `appended` (raw or base64) arrays; UInt32/UInt64 header; uncompressed, zlib or LZ4 | ASCII (default) or inline base64 binary |
+//! | `.vtk` | legacy ASCII and BINARY `UNSTRUCTURED_GRID`, classic and 5.x `CELLS` layouts | legacy ASCII (version 4.2 layout) |
 //! | `.mesh` | ASCII medit (`Triangles`, `TrianglesP2`, `Tetrahedra`, `TetrahedraP2`) | ASCII medit, P2 (default) or linear |
 //! | `.stl` | ASCII and binary (3-node triangles, vertices welded exactly) | — |
 //! | `.off` | ASCII OFF and its COFF/NOFF/... variants, polygons split as fans | — |
@@ -25,17 +25,20 @@
 //! reserve more memory than the file's size justifies.
 //!
 //! What the writers put in a file:
-//! - `.msh`: one surface entity per distinct boundary tag, each in a physical group whose
-//!   tag is that boundary tag (so the tags read back unchanged), and one volume entity in
-//!   physical group [`VOLUME_TAG`]. A Gmsh physical tag must be positive: triangles with a
-//!   tag <= 0 are written on their own surface entity without a physical group, and read
-//!   back with that entity's tag (a fresh positive number).
+//! Every boundary part and the volume is a physical group with a positive number (see
+//! [`Groups`]): a positive triangle tag is its own group's number (so tags read back
+//! unchanged); tags <= 0 take the first free numbers (untagged triangles, tag 0, become
+//! group 1 named `boundary` when 1 is free); the volume's number is
+//! [`Groups::volume_tag`] (the input's, default [`VOLUME_TAG`]).
+//! - `.msh`: one surface entity per group, in that physical group; one volume entity in
+//!   the volume's group; `$PhysicalNames` with the input's names, `boundary` for the
+//!   untagged triangles and `volume` for an unnamed volume.
 //! - `.vtu`/`.vtk`: one unstructured grid holding both the tetrahedra (type 24) and the
 //!   boundary triangles (type 22), with an Int32 cell array `BoundaryTag` that holds each
-//!   triangle's tag and 0 for the tetrahedra (ParaView and meshio read mixed cells; use a
-//!   Threshold on the cell type or the tag to see one or the other).
-//! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = tag, and
-//!   `TetrahedraP2` with reference [`VOLUME_TAG`], in the order established in [`order`];
+//!   triangle's group number and 0 for the tetrahedra (ParaView and meshio read mixed
+//!   cells; use a Threshold on the cell type or the tag to see one or the other).
+//! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = group number, and
+//!   `TetrahedraP2` with the volume's number, in the order established in [`order`];
 //!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
 //!   instead (for meshio, MMG, TetGen, which do not read the P2 sections).
 
@@ -64,6 +67,7 @@ mod text_out;
 mod vtk;
 mod vtk_cells;
 mod vtu;
+mod vtu_data;
 mod vtu_write;
 mod weld;
 

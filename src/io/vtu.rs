@@ -1,20 +1,21 @@
 //! Reading VTK XML unstructured grid `.vtu` files.
 //!
-//! The XML is parsed by `quick-xml` (zero-copy over the in-memory file) and base64 by
-//! `base64`; the data arrays' numbers are parsed by our own cursor. Read: `ascii` arrays
-//! and inline `binary` (base64) arrays with a UInt32 or UInt64 header, either byte
-//! order, uncompressed, header encoded apart (as VTK does for compressed data) or in one
-//! stream with the data (as VTK and meshio do otherwise); compressed and `appended`
-//! arrays give a clear parse error. Several pieces are concatenated.
+//! The XML is parsed by `quick-xml` (zero-copy over the in-memory file); the data arrays'
+//! text numbers are parsed by our own cursor, binary ones through [`vtu_data`]. Read:
+//! `ascii` arrays, inline `binary` (base64) arrays, and `appended` arrays in an
+//! `<AppendedData>` section of `raw` or `base64` encoding (VTK's writer default); a
+//! UInt32 or UInt64 header, either byte order, uncompressed or zlib- or LZ4-compressed
+//! (meshio's and VTK's defaults). Several pieces are concatenated.
+//!
+//! [`vtu_data`]: super::vtu_data
 
-use base64::engine::general_purpose::STANDARD;
-use base64::Engine;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
 use std::borrow::Cow;
 
 use super::cursor::{capped, parse_f64, parse_i64, show, Cursor};
 use super::vtk_cells::{self, add_cell, tag_rank};
+use super::vtu_data::{array_bytes, base64_runs, Compressor, Layout};
 use super::RawMesh;
 use crate::error::{Error, Result};
 
@@ -99,6 +100,16 @@ struct Array<'a> {
     /// The content is a single slice of the file starting at `content_at`.
     in_file: bool,
     content: Cow<'a, [u8]>,
+    /// For an `appended` array: its offset into the appended data.
+    appended: Option<u64>,
+}
+
+/// An appended array of a piece, read when the `<AppendedData>` section is reached.
+struct Pending {
+    target: Target,
+    ty: NumType,
+    offset: u64,
+    at: usize,
 }
 
 #[derive(Default)]
@@ -111,6 +122,7 @@ struct Piece {
     offsets: Option<Values>,
     types: Option<Values>,
     tags: Option<(usize, Values)>,
+    pending: Vec<Pending>,
 }
 
 struct Vtu<'a> {
@@ -118,8 +130,11 @@ struct Vtu<'a> {
     name: &'a str,
     header64: bool,
     big_endian: bool,
-    compressed: bool,
+    compressor: Compressor,
     seen_file: bool,
+    /// Pieces waiting for their appended arrays (and the pieces after them, kept in
+    /// order), with the offsets of their `</Piece>`.
+    deferred: Vec<(Piece, usize)>,
     mesh: RawMesh,
     piece: Option<Piece>,
     array: Option<Array<'a>>,
@@ -132,8 +147,9 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
         name,
         header64: false,
         big_endian: false,
-        compressed: false,
+        compressor: Compressor::None,
         seen_file: false,
+        deferred: Vec::new(),
         mesh: RawMesh::default(),
         piece: None,
         array: None,
@@ -174,7 +190,8 @@ impl<'a> Vtu<'a> {
                 Event::Start(e) => {
                     let name = e.local_name().as_ref().to_vec();
                     if name == b"AppendedData" {
-                        // Everything we read precedes it; its raw bytes are not XML.
+                        // Everything else precedes it; its raw bytes are not XML.
+                        self.appended(&e, before, rd.buffer_position() as usize)?;
                         break;
                     }
                     self.open(&e, &path, before)?;
@@ -219,7 +236,73 @@ impl<'a> Vtu<'a> {
         if !self.seen_file {
             return Err(self.err(0, "not a VTK XML file: no <VTKFile> element"));
         }
+        if let Some(p) = self.deferred.first().and_then(|(p, _)| p.pending.first()) {
+            return Err(self.err(
+                p.at,
+                "an appended data array, but the file has no <AppendedData> section",
+            ));
+        }
         Ok(())
+    }
+
+    /// Read the deferred pieces' appended arrays from the `<AppendedData>` element
+    /// starting at `at`, whose start tag ends at `content`.
+    fn appended(&mut self, e: &BytesStart, at: usize, content: usize) -> Result<()> {
+        let encoding = attr(e, b"encoding").unwrap_or(Cow::Borrowed(b"raw"));
+        let base64 = match encoding.trim_ascii() {
+            b"raw" => false,
+            b"base64" => true,
+            other => {
+                return Err(self.err(
+                    at,
+                    format!("unknown appended data encoding '{}'", show(other)),
+                ))
+            }
+        };
+        // The data starts after an underscore.
+        let rest = &self.data[content.min(self.data.len())..];
+        let skip = rest.iter().take_while(|b| b.is_ascii_whitespace()).count();
+        if rest.get(skip) != Some(&b'_') {
+            return Err(self.err(content + skip, "<AppendedData> does not start with '_'"));
+        }
+        let start = content + skip + 1;
+        let layout = self.layout();
+        for (mut piece, end) in std::mem::take(&mut self.deferred) {
+            for p in std::mem::take(&mut piece.pending) {
+                let from = usize::try_from(p.offset)
+                    .ok()
+                    .and_then(|o| o.checked_add(start))
+                    .filter(|&o| o <= self.data.len())
+                    .ok_or_else(|| {
+                        self.err(
+                            p.at,
+                            format!(
+                                "appended data offset {} is past the end of the file",
+                                p.offset
+                            ),
+                        )
+                    })?;
+                let bytes: Cow<[u8]> = if base64 {
+                    Cow::Owned(base64_runs(&self.data[from..]).map_err(|m| self.err(p.at, m))?)
+                } else {
+                    Cow::Borrowed(&self.data[from..])
+                };
+                let values = array_bytes(&bytes, layout)
+                    .map_err(|m| self.err(p.at, m))
+                    .and_then(|b| self.values(&b, p.ty, p.at))?;
+                store(&mut piece, p.target, p.at, values);
+            }
+            self.finish_piece(piece, end)?;
+        }
+        Ok(())
+    }
+
+    fn layout(&self) -> Layout {
+        Layout {
+            header64: self.header64,
+            big_endian: self.big_endian,
+            compressor: self.compressor,
+        }
     }
 
     fn open(&mut self, e: &BytesStart, path: &[Vec<u8>], at: usize) -> Result<()> {
@@ -241,8 +324,8 @@ impl<'a> Vtu<'a> {
                 self.header64 = attr(e, b"header_type").as_deref() == Some(b"UInt64".as_slice());
                 self.big_endian =
                     attr(e, b"byte_order").as_deref() == Some(b"BigEndian".as_slice());
-                self.compressed =
-                    attr(e, b"compressor").is_some_and(|c| !c.trim_ascii().is_empty());
+                self.compressor = Compressor::parse(attr(e, b"compressor").as_deref())
+                    .map_err(|m| self.err(at, m))?;
             }
             b"Piece" => {
                 if parent != Some(b"UnstructuredGrid".as_slice()) {
@@ -275,6 +358,7 @@ impl<'a> Vtu<'a> {
                 content_at: None,
                 in_file: false,
                 content: Cow::Borrowed(b""),
+                appended: None,
             });
             return Ok(());
         };
@@ -300,6 +384,7 @@ impl<'a> Vtu<'a> {
         let tyname = attr(e, b"type").unwrap_or(Cow::Borrowed(b""));
         let ty = NumType::parse(&tyname);
         let format = attr(e, b"format").unwrap_or(Cow::Borrowed(b"ascii"));
+        let mut appended = None;
         if target != Target::Skip {
             if ty.is_none() {
                 return Err(self.err(at, format!("unknown data type '{}'", show(&tyname))));
@@ -307,18 +392,11 @@ impl<'a> Vtu<'a> {
             match format.as_ref() {
                 b"ascii" | b"binary" => {}
                 b"appended" => {
-                    return Err(self.err(
-                        at,
-                        "appended data arrays are not supported (save the file with ASCII or inline binary data)",
-                    ))
+                    appended = Some(attr_u64(e, b"offset").ok_or_else(|| {
+                        self.err(at, "an appended data array without a valid offset")
+                    })?)
                 }
                 f => return Err(self.err(at, format!("unknown data format '{}'", show(f)))),
-            }
-            if format.as_ref() == b"binary" && self.compressed {
-                return Err(self.err(
-                    at,
-                    "compressed binary data arrays are not supported (save the file uncompressed)",
-                ));
             }
         } else {
             target = Target::Skip;
@@ -331,6 +409,7 @@ impl<'a> Vtu<'a> {
             content_at: None,
             in_file: false,
             content: Cow::Borrowed(b""),
+            appended,
         });
         Ok(())
     }
@@ -370,7 +449,11 @@ impl<'a> Vtu<'a> {
             }
             b"Piece" => {
                 if let Some(p) = self.piece.take() {
-                    self.finish_piece(p, at)?;
+                    if p.pending.is_empty() && self.deferred.is_empty() {
+                        self.finish_piece(p, at)?;
+                    } else {
+                        self.deferred.push((p, at));
+                    }
                 }
             }
             _ => {}
@@ -379,21 +462,27 @@ impl<'a> Vtu<'a> {
     }
 
     fn finish_array(&mut self, a: Array<'a>) -> Result<()> {
+        if let Some(offset) = a.appended {
+            let piece = self.piece.as_mut().expect("arrays are read inside a piece");
+            piece.pending.push(Pending {
+                target: a.target,
+                ty: a.ty,
+                offset,
+                at: a.at,
+            });
+            return Ok(());
+        }
         let at = a.content_at.unwrap_or(a.at);
         let values = if a.binary {
-            self.decode_binary(&a.content, a.ty, at)?
+            let bytes = base64_runs(a.content.trim_ascii())
+                .and_then(|b| array_bytes(&b, self.layout()))
+                .map_err(|m| self.err(at, m))?;
+            self.values(&bytes, a.ty, at)?
         } else {
             self.decode_ascii(&a, at)?
         };
         let piece = self.piece.as_mut().expect("arrays are read inside a piece");
-        match a.target {
-            Target::Points => piece.points = Some(values),
-            Target::Connectivity => piece.conn = Some((at, values)),
-            Target::Offsets => piece.offsets = Some(values),
-            Target::Types => piece.types = Some(values),
-            Target::Tag(r) => piece.tags = Some((r, values)),
-            Target::Skip => {}
-        }
+        store(piece, a.target, at, values);
         Ok(())
     }
 
@@ -436,58 +525,8 @@ impl<'a> Vtu<'a> {
         }
     }
 
-    fn decode_binary(&self, content: &[u8], ty: NumType, at: usize) -> Result<Values> {
-        let trimmed = content.trim_ascii();
-        let b64: Cow<[u8]> = if trimmed.iter().any(|b| b.is_ascii_whitespace()) {
-            Cow::Owned(
-                trimmed
-                    .iter()
-                    .copied()
-                    .filter(|b| !b.is_ascii_whitespace())
-                    .collect(),
-            )
-        } else {
-            Cow::Borrowed(trimmed)
-        };
-        let hsize: usize = if self.header64 { 8 } else { 4 };
-        let hchars = hsize.div_ceil(3) * 4;
-        if b64.len() < hchars {
-            return Err(self.err(at, "binary data array shorter than its header"));
-        }
-        let bad = |e: base64::DecodeError| self.err(at, format!("invalid base64 data: {e}"));
-        // VTK may encode the header separately (then it ends in exactly `pad` '='s: two
-        // for a 4-byte header, one for 8 bytes) or in one stream with the data.
-        let pad = (3 - hsize % 3) % 3;
-        let separate =
-            b64[hchars - pad..hchars].iter().all(|&b| b == b'=') && b64[hchars - pad - 1] != b'=';
-        let (header, payload) = if separate {
-            let h = STANDARD.decode(&b64[..hchars]).map_err(bad)?;
-            let p = STANDARD.decode(&b64[hchars..]).map_err(bad)?;
-            (h, p)
-        } else {
-            let mut all = STANDARD.decode(&b64).map_err(bad)?;
-            let p = all.split_off(hsize.min(all.len()));
-            (all, p)
-        };
-        if header.len() < hsize {
-            return Err(self.err(at, "binary data array shorter than its header"));
-        }
-        let mut h = [0u8; 8];
-        h[..hsize].copy_from_slice(&header[..hsize]);
-        if self.big_endian {
-            h[..hsize].reverse();
-        }
-        let nbytes = u64::from_le_bytes(h);
-        if nbytes > payload.len() as u64 {
-            return Err(self.err(
-                at,
-                format!(
-                    "binary data array declares {nbytes} bytes but holds {}",
-                    payload.len()
-                ),
-            ));
-        }
-        let payload = &payload[..nbytes as usize];
+    /// The values of an array's data bytes (file byte order).
+    fn values(&self, payload: &[u8], ty: NumType, at: usize) -> Result<Values> {
         let size = ty.size();
         if payload.len() % size != 0 {
             return Err(self.err(
@@ -554,6 +593,7 @@ impl<'a> Vtu<'a> {
             offsets,
             types,
             tags,
+            pending: _,
         } = p;
         let base = self.mesh.nodes.len() as u64;
         if base.saturating_add(npoints) >= u32::MAX as u64 {
@@ -664,5 +704,17 @@ impl<'a> Vtu<'a> {
             .map_err(|m| self.err(conn_at, m))?;
         }
         Ok(())
+    }
+}
+
+/// Put an array's values where they belong in the piece.
+fn store(piece: &mut Piece, target: Target, at: usize, values: Values) {
+    match target {
+        Target::Points => piece.points = Some(values),
+        Target::Connectivity => piece.conn = Some((at, values)),
+        Target::Offsets => piece.offsets = Some(values),
+        Target::Types => piece.types = Some(values),
+        Target::Tag(r) => piece.tags = Some((r, values)),
+        Target::Skip => {}
     }
 }
