@@ -505,3 +505,131 @@ fn groups_survive_every_output_format() {
         "meshio warned:\n{text}"
     );
 }
+
+/// A P2 sphere mesh split into two regions by the plane x = 0 (tets by centroid), as an
+/// MSH 2.2 file: the outer triangles (tag 1), the interface triangles between the regions
+/// (tag 9), the tets with region tags 1 and 2 (or all 1 with `one_region`). Returns the
+/// number of interface triangles.
+fn two_region_sphere(path: &Path, one_region: bool) -> usize {
+    use std::collections::HashMap;
+    use std::fmt::Write;
+    let raw = curvetet::io::read(&data("sphere_p2.msh")).unwrap();
+    let surface = curvetet::io::surface_from_raw(raw, "sphere").unwrap();
+    let opts = curvetet::Options {
+        optimize: false,
+        ..Default::default()
+    };
+    let m = curvetet::generate(&surface, &opts).unwrap().mesh;
+    let region: Vec<i32> = m
+        .tets
+        .iter()
+        .map(|t| {
+            let x: f64 = t[..4].iter().map(|&v| m.nodes[v as usize][0]).sum();
+            if x > 0.0 || one_region {
+                1
+            } else {
+                2
+            }
+        })
+        .collect();
+    let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+    const EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1)];
+    for t in &m.tets {
+        for (k, &(i, j)) in EDGES.iter().enumerate() {
+            mid.insert((t[i].min(t[j]), t[i].max(t[j])), t[4 + k]);
+        }
+    }
+    // Faces by sorted corners -> the tets holding them.
+    let mut faces: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    for (ti, t) in m.tets.iter().enumerate() {
+        for f in [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]] {
+            let mut k = [t[f[0]], t[f[1]], t[f[2]]];
+            k.sort_unstable();
+            faces.entry(k).or_default().push(ti);
+        }
+    }
+    let x_centroid = |t: usize| -> bool {
+        let x: f64 = m.tets[t][..4].iter().map(|&v| m.nodes[v as usize][0]).sum();
+        x > 0.0
+    };
+    let mut interface: Vec<[u32; 6]> = faces
+        .iter()
+        .filter(|(_, ts)| ts.len() == 2 && x_centroid(ts[0]) != x_centroid(ts[1]))
+        .map(|(k, _)| {
+            let e = |a: u32, b: u32| mid[&(a.min(b), a.max(b))];
+            [
+                k[0],
+                k[1],
+                k[2],
+                e(k[0], k[1]),
+                e(k[1], k[2]),
+                e(k[2], k[0]),
+            ]
+        })
+        .collect();
+    interface.sort_unstable();
+    let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n");
+    writeln!(s, "{}", m.nodes.len()).unwrap();
+    for (i, p) in m.nodes.iter().enumerate() {
+        writeln!(s, "{} {:?} {:?} {:?}", i + 1, p[0], p[1], p[2]).unwrap();
+    }
+    let n = m.boundary.len() + interface.len() + m.tets.len();
+    write!(s, "$EndNodes\n$Elements\n{n}\n").unwrap();
+    let mut id = 0;
+    let mut element = |s: &mut String, ty: u32, tag: i32, nodes: &[u32]| {
+        id += 1;
+        write!(s, "{id} {ty} 2 {tag} {tag}").unwrap();
+        for v in nodes {
+            write!(s, " {}", v + 1).unwrap();
+        }
+        s.push('\n');
+    };
+    for b in &m.boundary {
+        element(&mut s, 9, 1, b);
+    }
+    for b in &interface {
+        element(&mut s, 9, 9, b);
+    }
+    for (t, r) in m.tets.iter().zip(&region) {
+        element(&mut s, 11, *r, t);
+    }
+    s.push_str("$EndElements\n");
+    std::fs::write(path, s).unwrap();
+    interface.len()
+}
+
+/// Issue 30: `check` accepts a conforming two-region mesh whose interface triangles are
+/// listed with the boundary, reports the regions, and still refuses such triangles
+/// inside one region (a cavity filled with tets would look the same).
+#[test]
+fn check_accepts_two_regions_with_their_interface() {
+    let two = tmp("two_regions.msh");
+    let k = two_region_sphere(&two, false);
+    assert!(k > 50, "{k} interface triangles");
+    let out = run(&["check", two.to_str().unwrap(), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["valid"], true);
+    assert_eq!(j["conformity"]["interface_faces"], k);
+    let regions: Vec<i64> = j["regions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["tag"].as_i64().unwrap())
+        .collect();
+    assert_eq!(regions, vec![1, 2]);
+    let text = run(&["check", two.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains(&format!("{k} interface triangles")));
+
+    let one = tmp("one_region_interface.msh");
+    two_region_sphere(&one, true);
+    let out = run(&["check", one.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(6));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("is not a face of one tet"), "{err}");
+}

@@ -689,8 +689,19 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
         }
         return Ok(());
     }
+    // Region ids: the tets' tags, when they are not all one.
+    let regions = if raw.tet10_tags.windows(2).any(|w| w[0] != w[1]) {
+        raw.tet10_tags.clone()
+    } else {
+        Vec::new()
+    };
+    let region_counts: std::collections::BTreeMap<i32, usize> =
+        raw.tet10_tags.iter().fold(Default::default(), |mut c, &t| {
+            *c.entry(t).or_default() += 1;
+            c
+        });
     let m: TetMesh = raw.into_tet_mesh()?;
-    let conf = check::check_conformity(&m)?;
+    let conf = check::check_conformity_regions(&m, &regions)?;
     let report = QualityReport::of(&m);
     if let Some(p) = plot {
         write_plot(p, &report, &name)?;
@@ -700,6 +711,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
     if json {
         let j = serde_json::json!({
             "kind": "volume", "file": name, "valid": ok, "conformity": conf,
+            "regions": region_counts.iter().map(|(t, n)| serde_json::json!({"tag": t, "tets": n})).collect::<Vec<_>>(),
             "volume_relative_difference": rel, "report": report,
         });
         println!("{}", serde_json::to_string_pretty(&j).unwrap_or_default());
@@ -717,6 +729,17 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
             "  conforming: {} interior faces shared by two tets, boundary closed",
             conf.interior_faces
         );
+        if region_counts.len() > 1 {
+            let list: Vec<String> = region_counts
+                .iter()
+                .map(|(t, n)| format!("{t} ({n} tets)"))
+                .collect();
+            println!(
+                "  regions: {}; {} interface triangles between them",
+                list.join(", "),
+                conf.interface_faces
+            );
+        }
         println!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved);
         println!("  certified-invalid elements: {}", report.num_invalid);
         println!(
