@@ -633,3 +633,135 @@ fn check_accepts_two_regions_with_their_interface() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("is not a face of one tet"), "{err}");
 }
+
+/// Issue 30: the CLI's outputs carry what the other doors do. Its .vtu and .vtk meshes
+/// have the per-tet `ScaledJacobian` and `EquiangularSkewness` cell arrays (as the VTK
+/// filter's output; meshio reads them, and their extremes are the report's); its
+/// `--report` has the crate version, the options used and per-stage times including
+/// reading and writing.
+#[test]
+fn cli_vtu_has_quality_arrays_and_report_has_version_options_times() {
+    let vtu = tmp("quality.vtu");
+    let vtk = tmp("quality.vtk");
+    let report = tmp("quality.json");
+    let out = run(&[
+        "mesh",
+        data("sphere_lin.off").to_str().unwrap(),
+        "-o",
+        vtu.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--alpha",
+        "1.4",
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["curvetet_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(r["options"]["alpha"], 1.4);
+    assert_eq!(r["options"]["size"], "graded");
+    assert_eq!(r["options"]["optimize"], true);
+    assert_eq!(r["input"]["feature_angle"], 40.0);
+    assert!(r["input"]["path"]
+        .as_str()
+        .unwrap()
+        .ends_with("sphere_lin.off"));
+    for stage in [
+        "read",
+        "size_field",
+        "front",
+        "assemble",
+        "optimize",
+        "certify",
+        "report",
+        "write",
+    ] {
+        let t = r["times"][stage].as_f64().unwrap_or(-1.0);
+        assert!(t > 0.0, "{stage}: {}", r["times"]);
+    }
+    let out = run(&["convert", vtu.to_str().unwrap(), vtk.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let min_sj = r["report"]["quality"]["scaled_jacobian"]["min"]
+        .as_f64()
+        .unwrap();
+    let max_skew = r["report"]["quality"]["skewness"]["max"].as_f64().unwrap();
+    let ntets = r["report"]["num_tets"].as_u64().unwrap();
+    let script = r#"
+import sys, json
+import numpy as np
+import meshio
+for path in sys.argv[1:]:
+    m = meshio.read(path)
+    sj = np.concatenate([d for b, d in zip(m.cells, m.cell_data["ScaledJacobian"]) if b.type == "tetra10"])
+    sk = np.concatenate([d for b, d in zip(m.cells, m.cell_data["EquiangularSkewness"]) if b.type == "tetra10"])
+    print(json.dumps([len(sj), float(sj.min()), float(sj.max()), float(sk.max())]))
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script, vtu.to_str().unwrap(), vtk.to_str().unwrap()])
+        .output()
+        .expect("python3 runs (scripts/install-deps installs meshio)");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    for line in lines {
+        let v: Vec<f64> = serde_json::from_str(line).unwrap();
+        assert_eq!(v[0] as u64, ntets);
+        // The .vtk holds 17 significant digits, as the .vtu.
+        assert!(
+            (v[1] - min_sj).abs() <= 1e-12 * min_sj,
+            "{v:?} vs min SJ {min_sj}"
+        );
+        assert!(v[2] <= 1.0 + 1e-12, "{v:?}");
+        assert!(
+            (v[3] - max_skew).abs() <= 1e-12,
+            "{v:?} vs max skewness {max_skew}"
+        );
+    }
+}
+
+/// Issue 30: the progress callback (and so the CLI's progress bar) reports an optimize
+/// stage between the front and the certification, and none when optimization is off.
+#[test]
+fn progress_reports_the_optimize_stage() {
+    let raw = curvetet::io::read(&data("sphere_p2.msh")).unwrap();
+    let surface = curvetet::io::surface_from_raw(raw, "sphere").unwrap();
+    for optimize in [true, false] {
+        let opts = curvetet::Options {
+            optimize,
+            ..Default::default()
+        };
+        let mut stages: Vec<(String, f64)> = Vec::new();
+        curvetet::generate_with_progress(&surface, &opts, &mut |f, s| {
+            if stages.last().map(|x| x.0.as_str()) != Some(s) || s == "optimize" {
+                stages.push((s.to_string(), f));
+            }
+            false
+        })
+        .unwrap();
+        let names: Vec<&str> = stages.iter().map(|s| s.0.as_str()).collect();
+        if optimize {
+            assert_eq!(
+                names,
+                ["front", "optimize", "optimize", "certify"],
+                "{stages:?}"
+            );
+            assert_eq!((stages[1].1, stages[2].1), (0.0, 0.5));
+        } else {
+            assert_eq!(names, ["front", "certify"], "{stages:?}");
+        }
+    }
+}

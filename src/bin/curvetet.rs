@@ -232,6 +232,8 @@ impl WriteArgs {
                 MshVersion::V41
             },
             binary: self.binary,
+            // The VTK filter's per-tet quality arrays, in .vtu and .vtk meshes.
+            quality_arrays: true,
             ..WriteOptions::default()
         }
     }
@@ -326,7 +328,44 @@ fn progress_bar(quiet: bool) -> ProgressBar {
     pb
 }
 
-fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Error> {
+/// The options a mesh was made and written with, for `--report`.
+fn options_json(o: &Options, w: &WriteOptions) -> serde_json::Value {
+    serde_json::json!({
+        "alpha": o.alpha,
+        "size": match o.size {
+            SizeMode::Graded => serde_json::json!("graded"),
+            SizeMode::Uniform => serde_json::json!("uniform"),
+            SizeMode::Fixed(h) => serde_json::json!(h),
+        },
+        "size_from": o.size_from,
+        "gradation": o.gradation,
+        "optimize": o.optimize,
+        "thorough": o.thorough,
+        "threads": o.threads,
+        "min_dihedral_deg": o.min_dihedral_deg,
+        "max_skewness": o.max_skewness,
+        "min_edge_face_angle_deg": o.min_edge_face_angle_deg,
+        "msh_version": match w.msh_version {
+            MshVersion::V41 => "4.1",
+            MshVersion::V22 => "2.2",
+        },
+        "binary": w.binary,
+    })
+}
+
+/// Where the surface came from and how long reading (and curving) it took, for
+/// `--report`.
+struct InputInfo {
+    json: serde_json::Value,
+    read_seconds: f64,
+}
+
+fn run_mesh(
+    surface: &Surface,
+    m: &MeshOptions,
+    output: &Path,
+    input: InputInfo,
+) -> Result<(), Error> {
     for w in surface.warnings() {
         eprintln!("warning: {w}");
     }
@@ -370,7 +409,9 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
             return Err(e);
         }
     };
+    let t = std::time::Instant::now();
     io::write_mesh(output, &g.mesh, &m.write.options())?;
+    let write_seconds = t.elapsed().as_secs_f64();
     let r = &g.report;
     eprintln!(
         "{} tets, {} nodes in {:.3} s (front {:.3} s); min scaled Jacobian {:.3} (certified {:.3}), max skewness {:.3}, dihedral {:.1}..{:.1} deg",
@@ -389,11 +430,19 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
         write_plot(p, r, &output.display().to_string())?;
     }
     if let Some(path) = &m.report {
+        let mut times =
+            serde_json::to_value(&g.times).map_err(|e| Error::InvalidArgument(e.to_string()))?;
+        times["read"] = input.read_seconds.into();
+        times["write"] = write_seconds.into();
         let json = serde_json::json!({
+            "curvetet_version": env!("CARGO_PKG_VERSION"),
+            "input": input.json,
+            "output": output.display().to_string(),
+            "options": options_json(&opts, &m.write.options()),
             "input_triangles": surface.triangles().len(),
             "report": r,
             "front": g.front,
-            "times": g.times,
+            "times": times,
             "optimize": g.optimize,
             "size": g.size,
             "size_from": g.size_from,
@@ -479,8 +528,17 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     }
     // The surface checks (parallel) run on as many threads as the meshing: `--threads 1`
     // is one thread from start to end.
+    let t = std::time::Instant::now();
     let surface = curvetet::threads::pool(a.mesh.threads, true)?
         .install(|| read_surface_any(&a.input, &a.curve))?;
+    let input = InputInfo {
+        json: serde_json::json!({
+            "path": a.input.display().to_string(),
+            "feature_angle": a.curve.feature_angle,
+            "smooth": a.curve.smooth,
+        }),
+        read_seconds: t.elapsed().as_secs_f64(),
+    };
     if let Some(budget) = a.max_memory {
         let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
         if need > budget {
@@ -494,7 +552,7 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
             )));
         }
     }
-    run_mesh(&surface, &a.mesh, &a.output)
+    run_mesh(&surface, &a.mesh, &a.output, input)
 }
 
 fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
@@ -557,7 +615,11 @@ fn cmd_demo(
         )?;
         eprintln!("wrote {}", p.display());
     }
-    run_mesh(&surface, m, output)
+    let input = InputInfo {
+        json: serde_json::json!({"demo": "torus", "R": big_r, "r": r, "triangles": n}),
+        read_seconds: 0.0,
+    };
+    run_mesh(&surface, m, output, input)
 }
 
 fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> {

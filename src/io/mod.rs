@@ -293,6 +293,10 @@ pub struct WriteOptions {
     /// For .mesh only: write linear `Triangles` and `Tetrahedra` (corner nodes) instead of
     /// `TrianglesP2` and `TetrahedraP2`, for tools that read only linear medit files.
     pub medit_linear: bool,
+    /// For .vtu and .vtk: add the Float64 cell arrays `ScaledJacobian` (sampled min J /
+    /// max J) and `EquiangularSkewness` of each tetrahedron (0 for the triangles), as the
+    /// VTK filter's output has.
+    pub quality_arrays: bool,
 }
 
 /// What the writers see: a validated P2 mesh or surface.
@@ -354,10 +358,15 @@ fn write_view<W: Write>(
         tags: &tags,
         ..*view
     };
+    let quality = (opts.quality_arrays
+        && !view.tet10.is_empty()
+        && matches!(format, Format::Vtu | Format::Vtk))
+    .then(|| tet_quality_arrays(view));
+    let quality = quality.as_deref();
     match format {
         Format::Msh => msh_write::write(w, view, opts),
-        Format::Vtu => vtu_write::write(w, &resolved, opts.binary),
-        Format::Vtk => vtk::write(w, &resolved),
+        Format::Vtu => vtu_write::write(w, &resolved, quality, opts.binary),
+        Format::Vtk => vtk::write(w, &resolved, quality),
         Format::Medit => medit::write(w, &resolved, groups.volume, opts.medit_linear),
         // Refused by `check_options` before any byte is written.
         Format::Stl | Format::Off | Format::Obj | Format::Ply => Err(std::io::Error::new(
@@ -365,6 +374,19 @@ fn write_view<W: Write>(
             "linear surface formats are read only",
         )),
     }
+}
+
+/// (scaled Jacobian, equiangular skewness) of each tetrahedron.
+fn tet_quality_arrays(view: &MeshView) -> Vec<[f64; 2]> {
+    use rayon::prelude::*;
+    view.tet10
+        .par_iter()
+        .map(|t| {
+            let x: [P3; 10] = std::array::from_fn(|k| view.nodes[t[k] as usize]);
+            let q = crate::geom::quality::tet_quality(&x);
+            [q.scaled_jacobian, q.skewness]
+        })
+        .collect()
 }
 
 fn check_options(format: Format, opts: &WriteOptions, view: &MeshView) -> Result<()> {

@@ -10,14 +10,19 @@
 use std::io::{self, Write};
 
 use super::cursor::{capped, parse_f64, parse_i64, show, Cursor};
-use super::text_out::{int, point, uint};
-use super::vtk_cells::{self, add_cell, tag_rank, TAG_ARRAY};
+use super::text_out::{float, int, point, uint};
+use super::vtk_cells::{self, add_cell, tag_rank, QUALITY_ARRAYS, TAG_ARRAY};
 use super::{MeshView, RawMesh};
 use crate::error::Result;
 
 /// Write an ASCII legacy VTK file (version 4.2 layout): tetrahedra and boundary
-/// triangles, and the Int32 cell array `BoundaryTag`.
-pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView) -> io::Result<()> {
+/// triangles, the Int32 cell array `BoundaryTag`, and with `quality` (per tetrahedron)
+/// the double cell arrays of [`QUALITY_ARRAYS`] (0 for triangles).
+pub(crate) fn write<W: Write>(
+    w: &mut W,
+    view: &MeshView,
+    quality: Option<&[[f64; 2]]>,
+) -> io::Result<()> {
     w.write_all(
         b"# vtk DataFile Version 4.2\ncurvetet P2 mesh\nASCII\nDATASET UNSTRUCTURED_GRID\n",
     )?;
@@ -57,6 +62,20 @@ pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView) -> io::Result<()> {
     for c in vtk_cells::cells(view) {
         int(w, c.tag as i64)?;
         w.write_all(b"\n")?;
+    }
+    for (k, name) in QUALITY_ARRAYS.iter().enumerate() {
+        let Some(q) = quality else { break };
+        w.write_all(b"SCALARS ")?;
+        w.write_all(name.as_bytes())?;
+        w.write_all(b" double 1\nLOOKUP_TABLE default\n")?;
+        for v in q
+            .iter()
+            .map(|e| e[k])
+            .chain((0..view.tri6.len()).map(|_| 0.0))
+        {
+            float(w, v)?;
+            w.write_all(b"\n")?;
+        }
     }
     Ok(())
 }
