@@ -311,7 +311,7 @@ fn mesh_plots_the_two_histograms_and_optimization_can_be_turned_off() {
 
 /// Checks each file of a JSON list with meshio: it reads without warning, holds P2 tets
 /// and triangles, the triangles' and tets' tags (cell array `key`) are the given sets, and
-/// for .msh files the physical names are the given (name, tag, dim) triples.
+/// for .msh and .vtu files the physical names are the given (name, tag, dim) triples.
 const MESHIO_GROUPS: &str = r#"
 import json, sys, warnings
 import numpy as np
@@ -330,7 +330,7 @@ for f in spec:
     assert sorted(tri) == f["tri"], (f["path"], sorted(tri), f["tri"])
     assert sorted(tet) == f["tet"], (f["path"], sorted(tet), f["tet"])
     if "names" in f:
-        got = sorted([k, int(v[0]), int(v[1])] for k, v in m.field_data.items())
+        got = sorted([k] + [int(x) for x in np.asarray(v).reshape(-1)] for k, v in m.field_data.items())
         assert got == sorted(f["names"]), (f["path"], got, f["names"])
 print("meshio ok", len(spec))
 "#;
@@ -369,9 +369,9 @@ fn named_sphere(path: &Path) {
 
 /// Issue 30: every output of a tagged-and-named input and of an untagged one, in every
 /// format and encoding, is read by meshio without warning, with a physical group for each
-/// boundary part and for the volume: the input's numbers and names, or `boundary` 1 and
-/// `volume` 1. curvetet reads the same numbers and names back, and Gmsh opens the .msh
-/// files without a warning.
+/// boundary part and for the volume: the input's numbers and names (.msh: physical names;
+/// .vtu: field data as meshio keeps them), or `boundary` 1 and `volume` 1. curvetet reads
+/// the same numbers and names back, and Gmsh opens the .msh files without a warning.
 #[test]
 fn groups_survive_every_output_format() {
     let named = tmp("named_sphere.msh");
@@ -435,14 +435,15 @@ fn groups_survive_every_output_format() {
                 String::from_utf8_lossy(&out.stderr)
             );
             let msh = suffix.ends_with(".msh");
+            let named = msh || suffix.ends_with(".vtu");
             // curvetet reads back the input's numbers (and, from .msh, names).
             let back = curvetet::io::read(&path).unwrap();
             let mut got: Vec<i32> = back.tri6_tags.clone();
             got.sort_unstable();
             got.dedup();
             assert_eq!(&got, tri, "{name} {suffix}");
-            if msh {
-                assert!(back.tet10_tags.iter().all(|t| t == vol), "{name} {suffix}");
+            if named {
+                assert_eq!(back.groups().volume_tag, *vol, "{name} {suffix}");
                 let mut got: Vec<(String, i32, u8)> = back
                     .physical_names
                     .iter()
@@ -455,6 +456,9 @@ fn groups_survive_every_output_format() {
                     .collect();
                 want.sort();
                 assert_eq!(got, want, "{name} {suffix}");
+            }
+            if msh {
+                assert!(back.tet10_tags.iter().all(|t| t == vol), "{name} {suffix}");
                 if gmsh {
                     let o = Command::new("gmsh")
                         .args([path.to_str().unwrap(), "-0", "-o"])
@@ -476,7 +480,7 @@ fn groups_survive_every_output_format() {
                 "tri": tri,
                 "tet": if msh { vec![*vol] } else { vec![0] },
             });
-            if msh {
+            if named {
                 entry["names"] = serde_json::json!(names
                     .iter()
                     .map(|&(n, t, d)| serde_json::json!([n, t, d]))

@@ -36,7 +36,9 @@
 //! - `.vtu`/`.vtk`: one unstructured grid holding both the tetrahedra (type 24) and the
 //!   boundary triangles (type 22), with an Int32 cell array `BoundaryTag` that holds each
 //!   triangle's group number and 0 for the tetrahedra (ParaView and meshio read mixed
-//!   cells; use a Threshold on the cell type or the tag to see one or the other).
+//!   cells; use a Threshold on the cell type or the tag to see one or the other); a
+//!   `.vtu` names the groups in field data arrays (name -> (number, dimension)), read back
+//!   into [`RawMesh::physical_names`].
 //! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = group number, and
 //!   `TetrahedraP2` with the volume's number, in the order established in [`order`];
 //!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
@@ -112,8 +114,8 @@ pub struct RawMesh {
 
 impl RawMesh {
     /// The volume's tag and the group names: the tag of the first 10-node (else 4-node)
-    /// tetrahedron when positive; without tetrahedra, the only named volume group if
-    /// there is exactly one; else [`VOLUME_TAG`].
+    /// tetrahedron when positive; else (a surface, or tets tagged 0 as in a .vtu) the
+    /// only named volume group if there is exactly one; else [`VOLUME_TAG`].
     pub fn groups(&self) -> Groups {
         let from_tets = self
             .tet10_tags
@@ -128,7 +130,7 @@ impl RawMesh {
         };
         let tets = !self.tet10_tags.is_empty() || !self.tet4_tags.is_empty();
         Groups {
-            volume_tag: if tets { from_tets } else { named }.unwrap_or(VOLUME_TAG),
+            volume_tag: if tets { from_tets.or(named) } else { named }.unwrap_or(VOLUME_TAG),
             names: self.physical_names.clone(),
         }
     }
@@ -365,7 +367,7 @@ fn write_view<W: Write>(
     let quality = quality.as_deref();
     match format {
         Format::Msh => msh_write::write(w, view, opts),
-        Format::Vtu => vtu_write::write(w, &resolved, quality, opts.binary),
+        Format::Vtu => vtu_write::write(w, &resolved, &groups.names, quality, opts.binary),
         Format::Vtk => vtk::write(w, &resolved, quality),
         Format::Medit => medit::write(w, &resolved, groups.volume, opts.medit_linear),
         // Refused by `check_options` before any byte is written.

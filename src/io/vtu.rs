@@ -16,7 +16,7 @@ use std::borrow::Cow;
 use super::cursor::{capped, parse_f64, parse_i64, show, Cursor};
 use super::vtk_cells::{self, add_cell, tag_rank};
 use super::vtu_data::{array_bytes, base64_runs, Compressor, Layout};
-use super::RawMesh;
+use super::{PhysicalName, RawMesh};
 use crate::error::{Error, Result};
 
 /// Element types of data arrays.
@@ -86,6 +86,9 @@ enum Target {
     Offsets,
     Types,
     Tag(usize),
+    /// A field data array (tag, dimension) naming a physical group, as meshio writes
+    /// Gmsh's physical names.
+    Group,
     Skip,
 }
 
@@ -102,6 +105,8 @@ struct Array<'a> {
     content: Cow<'a, [u8]>,
     /// For an `appended` array: its offset into the appended data.
     appended: Option<u64>,
+    /// Its `Name` (kept for [`Target::Group`] arrays only).
+    name: String,
 }
 
 /// An appended array of a piece, read when the `<AppendedData>` section is reached.
@@ -350,15 +355,31 @@ impl<'a> Vtu<'a> {
 
     fn open_array(&mut self, e: &BytesStart, parent: Option<&[u8]>, at: usize) -> Result<()> {
         let Some(piece) = &self.piece else {
+            // Outside a piece: only a group's name, (tag, dim) of an integer type in ascii
+            // or inline binary, is read; anything else there is skipped.
+            let ty = attr(e, b"type").and_then(|t| NumType::parse(&t));
+            let format = attr(e, b"format");
+            let group = parent == Some(b"FieldData".as_slice())
+                && attr_u64(e, b"NumberOfComponents") == Some(2)
+                && attr_u64(e, b"NumberOfTuples").unwrap_or(1) == 1
+                && ty.is_some_and(|t| !t.is_float())
+                && matches!(format.as_deref(), Some(b"ascii") | Some(b"binary") | None);
             self.array = Some(Array {
-                target: Target::Skip,
-                ty: NumType::U8,
-                binary: false,
+                target: if group { Target::Group } else { Target::Skip },
+                ty: ty.unwrap_or(NumType::U8),
+                binary: format.as_deref() == Some(b"binary".as_slice()),
                 at,
                 content_at: None,
                 in_file: false,
                 content: Cow::Borrowed(b""),
                 appended: None,
+                name: attr(e, b"Name")
+                    .and_then(|n| {
+                        quick_xml::escape::unescape(&String::from_utf8_lossy(&n))
+                            .ok()
+                            .map(|c| c.into_owned())
+                    })
+                    .unwrap_or_default(),
             });
             return Ok(());
         };
@@ -410,6 +431,7 @@ impl<'a> Vtu<'a> {
             in_file: false,
             content: Cow::Borrowed(b""),
             appended,
+            name: String::new(),
         });
         Ok(())
     }
@@ -442,7 +464,9 @@ impl<'a> Vtu<'a> {
         match name {
             b"DataArray" => {
                 if let Some(a) = self.array.take() {
-                    if a.target != Target::Skip {
+                    if a.target == Target::Group {
+                        self.group_name(a)?;
+                    } else if a.target != Target::Skip {
                         self.finish_array(a)?;
                     }
                 }
@@ -457,6 +481,31 @@ impl<'a> Vtu<'a> {
                 }
             }
             _ => {}
+        }
+        Ok(())
+    }
+
+    /// A field data array naming a group: kept when it holds (tag, dimension 0..3).
+    fn group_name(&mut self, a: Array<'a>) -> Result<()> {
+        let at = a.content_at.unwrap_or(a.at);
+        let values = if a.binary {
+            let bytes = base64_runs(a.content.trim_ascii())
+                .and_then(|b| array_bytes(&b, self.layout()))
+                .map_err(|m| self.err(at, m))?;
+            self.values(&bytes, a.ty, at)?
+        } else {
+            self.decode_ascii(&a, at)?
+        };
+        if let Values::I(v) = values {
+            if let [tag, dim] = v[..] {
+                if let (Ok(tag), true) = (i32::try_from(tag), (0..=3).contains(&dim)) {
+                    self.mesh.physical_names.push(PhysicalName {
+                        dim: dim as u8,
+                        tag,
+                        name: a.name,
+                    });
+                }
+            }
         }
         Ok(())
     }
@@ -715,6 +764,6 @@ fn store(piece: &mut Piece, target: Target, at: usize, values: Values) {
         Target::Offsets => piece.offsets = Some(values),
         Target::Types => piece.types = Some(values),
         Target::Tag(r) => piece.tags = Some((r, values)),
-        Target::Skip => {}
+        Target::Group | Target::Skip => {}
     }
 }

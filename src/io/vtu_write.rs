@@ -8,20 +8,36 @@ use base64::engine::general_purpose::STANDARD;
 
 use super::text_out::{float, int, uint};
 use super::vtk_cells::{self, QUALITY_ARRAYS, TAG_ARRAY};
-use super::MeshView;
+use super::{MeshView, PhysicalName};
 
 /// Write a `.vtu` file with the tetrahedra and the boundary triangles, the Int32 cell
 /// array `BoundaryTag` (0 for tetrahedra), and with `quality` (per tetrahedron) the
-/// Float64 cell arrays of [`QUALITY_ARRAYS`] (0 for triangles).
+/// Float64 cell arrays of [`QUALITY_ARRAYS`] (0 for triangles). Each named group is a
+/// field data array of that name holding (tag, dimension), as meshio keeps Gmsh's
+/// physical names.
 pub(crate) fn write<W: Write>(
     w: &mut W,
     view: &MeshView,
+    names: &[PhysicalName],
     quality: Option<&[[f64; 2]]>,
     binary: bool,
 ) -> io::Result<()> {
     let (ncells, nconn) = vtk_cells::sizes(view);
     let format = if binary { "binary" } else { "ascii" };
     w.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n")?;
+    if !names.is_empty() {
+        w.write_all(b"    <FieldData>\n")?;
+        for n in names {
+            writeln!(
+                w,
+                "      <DataArray type=\"Int32\" Name=\"{}\" NumberOfTuples=\"1\" NumberOfComponents=\"2\" format=\"ascii\">{} {}</DataArray>",
+                quick_xml::escape::escape(n.name.as_str()),
+                n.tag,
+                n.dim
+            )?;
+        }
+        w.write_all(b"    </FieldData>\n")?;
+    }
     write!(
         w,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{ncells}\">\n      <Points>\n",
