@@ -159,6 +159,9 @@ fn generate_inner(
         times.front += t.elapsed().as_secs_f64();
 
         let mut ostats = OptimizeStats::default();
+        if opts.optimize && progress(0.0, "optimize") {
+            return Err(Error::Cancelled);
+        }
         let (pts, tets) = if opts.optimize {
             let t = Instant::now();
             let (pts, tets, st) = improve_linear_known(
@@ -183,9 +186,14 @@ fn generate_inner(
             surface.triangles(),
             surface.tags(),
         );
+        mesh.groups = surface.groups().clone();
         times.assemble += t.elapsed().as_secs_f64();
 
         if opts.optimize {
+            // The linear stage takes about as long as the high-order one.
+            if progress(0.5, "optimize") {
+                return Err(Error::Cancelled);
+            }
             let t = Instant::now();
             ostats.high_order =
                 pool.install(|| optimize_high_order(&mut mesh, &bnd, &high_order_params(opts)));

@@ -724,3 +724,464 @@ fn a_convert_interrupted_while_writing_leaves_the_old_file_and_no_temporary() {
     }
     assert!(caught > 0, "never caught a convert while it was writing");
 }
+
+/// Checks each file of a JSON list with meshio: it reads without warning, holds P2 tets
+/// and triangles, the triangles' and tets' tags (cell array `key`) are the given sets, and
+/// for .msh and .vtu files the physical names are the given (name, tag, dim) triples.
+const MESHIO_GROUPS: &str = r#"
+import json, sys, warnings
+import numpy as np
+import meshio
+spec = json.loads(sys.argv[1])
+for f in spec:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = meshio.read(f["path"])
+    kinds = sorted({b.type for b in m.cells})
+    assert kinds == ["tetra10", "triangle6"], (f["path"], kinds)
+    tri, tet = set(), set()
+    for b, d in zip(m.cells, m.cell_data[f["key"]]):
+        vals = {int(x) for x in np.asarray(d).reshape(-1)}
+        (tri if b.type == "triangle6" else tet).update(vals)
+    assert sorted(tri) == f["tri"], (f["path"], sorted(tri), f["tri"])
+    assert sorted(tet) == f["tet"], (f["path"], sorted(tet), f["tet"])
+    if "names" in f:
+        got = sorted([k] + [int(x) for x in np.asarray(v).reshape(-1)] for k, v in m.field_data.items())
+        assert got == sorted(f["names"]), (f["path"], got, f["names"])
+print("meshio ok", len(spec))
+"#;
+
+/// A P2 sphere whose triangles are tagged 3 (z > 0, "inlet") and 7 ("wall"), in a
+/// volume named "fluid" with tag 4: an MSH 2.2 file as Gmsh writes one with named
+/// physical groups.
+fn named_sphere(path: &Path) {
+    use curvetet::io;
+    let raw = io::read(&data("sphere_p2.msh")).unwrap();
+    let tags: Vec<i32> = raw
+        .tri6
+        .iter()
+        .map(|t| {
+            let z: f64 = t[..3].iter().map(|&v| raw.nodes[v as usize][2]).sum();
+            if z > 0.0 {
+                3
+            } else {
+                7
+            }
+        })
+        .collect();
+    let opts = io::WriteOptions {
+        msh_version: io::MshVersion::V22,
+        ..Default::default()
+    };
+    io::write_surface(path, &raw.nodes, &raw.tri6, &tags, &opts).unwrap();
+    let text = std::fs::read_to_string(path).unwrap();
+    // The writer names nothing on a surface of tagged triangles: add the names.
+    assert!(!text.contains("$PhysicalNames"));
+    let names =
+        "$PhysicalNames\n3\n2 3 \"inlet\"\n2 7 \"wall\"\n3 4 \"fluid\"\n$EndPhysicalNames\n";
+    let text = text.replacen("$EndMeshFormat\n", &format!("$EndMeshFormat\n{names}"), 1);
+    std::fs::write(path, text).unwrap();
+}
+
+/// Issue 30: every output of a tagged-and-named input and of an untagged one, in every
+/// format and encoding, is read by meshio without warning, with a physical group for each
+/// boundary part and for the volume: the input's numbers and names (.msh: physical names;
+/// .vtu: field data as meshio keeps them), or `boundary` 1 and `volume` 1. curvetet reads
+/// the same numbers and names back, and Gmsh opens the .msh files without a warning.
+#[test]
+fn groups_survive_every_output_format() {
+    let named = tmp("named_sphere.msh");
+    named_sphere(&named);
+    type Case = (
+        &'static str,
+        PathBuf,
+        Vec<i32>,
+        i32,
+        Vec<(&'static str, i32, u8)>,
+    );
+    let cases: Vec<Case> = vec![
+        (
+            "named",
+            named,
+            vec![3, 7],
+            4,
+            vec![("inlet", 3, 2), ("wall", 7, 2), ("fluid", 4, 3)],
+        ),
+        (
+            "untagged",
+            data("sphere_lin.off"),
+            vec![1],
+            1,
+            vec![("boundary", 1, 2), ("volume", 1, 3)],
+        ),
+    ];
+    let gmsh = Command::new("gmsh").arg("-version").output().is_ok();
+    let mut spec = Vec::new();
+    for (name, input, tri, vol, names) in &cases {
+        let first = tmp(&format!("groups_{name}.msh"));
+        let out = run(&[
+            "mesh",
+            input.to_str().unwrap(),
+            "-o",
+            first.to_str().unwrap(),
+            "-q",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let variants: [(&str, &[&str]); 7] = [
+            ("41.msh", &[]),
+            ("41b.msh", &["--binary"]),
+            ("22.msh", &["--msh22"]),
+            ("22b.msh", &["--msh22", "--binary"]),
+            ("a.vtu", &[]),
+            ("b.vtu", &["--binary"]),
+            ("a.vtk", &[]),
+        ];
+        for (suffix, flags) in variants {
+            let path = tmp(&format!("groups_{name}_{suffix}"));
+            let mut args = vec!["convert", first.to_str().unwrap(), path.to_str().unwrap()];
+            args.extend_from_slice(flags);
+            let out = run(&args);
+            assert!(
+                out.status.success(),
+                "{}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let msh = suffix.ends_with(".msh");
+            let named = msh || suffix.ends_with(".vtu");
+            // curvetet reads back the input's numbers (and, from .msh, names).
+            let back = curvetet::io::read(&path).unwrap();
+            let mut got: Vec<i32> = back.tri6_tags.clone();
+            got.sort_unstable();
+            got.dedup();
+            assert_eq!(&got, tri, "{name} {suffix}");
+            if named {
+                assert_eq!(back.groups().volume_tag, *vol, "{name} {suffix}");
+                let mut got: Vec<(String, i32, u8)> = back
+                    .physical_names
+                    .iter()
+                    .map(|n| (n.name.clone(), n.tag, n.dim))
+                    .collect();
+                got.sort();
+                let mut want: Vec<(String, i32, u8)> = names
+                    .iter()
+                    .map(|&(n, t, d)| (n.to_string(), t, d))
+                    .collect();
+                want.sort();
+                assert_eq!(got, want, "{name} {suffix}");
+            }
+            if msh {
+                assert!(back.tet10_tags.iter().all(|t| t == vol), "{name} {suffix}");
+                if gmsh {
+                    let o = Command::new("gmsh")
+                        .args([path.to_str().unwrap(), "-0", "-o"])
+                        .arg(tmp(&format!("groups_{name}_{suffix}_gmsh.msh")))
+                        .output()
+                        .unwrap();
+                    let text = String::from_utf8_lossy(&o.stdout).to_string()
+                        + &String::from_utf8_lossy(&o.stderr);
+                    assert!(o.status.success(), "gmsh {name} {suffix}: {text}");
+                    assert!(
+                        !text.contains("Warning") && !text.contains("Error"),
+                        "gmsh {name} {suffix}: {text}"
+                    );
+                }
+            }
+            let mut entry = serde_json::json!({
+                "path": path.to_str().unwrap(),
+                "key": if msh { "gmsh:physical" } else { "BoundaryTag" },
+                "tri": tri,
+                "tet": if msh { vec![*vol] } else { vec![0] },
+            });
+            if named {
+                entry["names"] = serde_json::json!(names
+                    .iter()
+                    .map(|&(n, t, d)| serde_json::json!([n, t, d]))
+                    .collect::<Vec<_>>());
+            }
+            spec.push(entry);
+        }
+    }
+    let out = Command::new("python3")
+        .args([
+            "-c",
+            MESHIO_GROUPS,
+            &serde_json::Value::from(spec).to_string(),
+        ])
+        .output()
+        .expect("python3 runs (scripts/install-deps installs meshio)");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(out.status.success(), "meshio failed:\n{text}");
+    assert!(text.contains("meshio ok 14"), "{text}");
+    assert!(
+        !text.to_lowercase().contains("warn"),
+        "meshio warned:\n{text}"
+    );
+}
+
+/// A P2 sphere mesh split into two regions by the plane x = 0 (tets by centroid), as an
+/// MSH 2.2 file: the outer triangles (tag 1), the interface triangles between the regions
+/// (tag 9), the tets with region tags 1 and 2 (or all 1 with `one_region`). Returns the
+/// number of interface triangles.
+fn two_region_sphere(path: &Path, one_region: bool) -> usize {
+    use std::collections::HashMap;
+    use std::fmt::Write;
+    let raw = curvetet::io::read(&data("sphere_p2.msh")).unwrap();
+    let surface = curvetet::io::surface_from_raw(raw, "sphere").unwrap();
+    let opts = curvetet::Options {
+        optimize: false,
+        ..Default::default()
+    };
+    let m = curvetet::generate(&surface, &opts).unwrap().mesh;
+    let region: Vec<i32> = m
+        .tets
+        .iter()
+        .map(|t| {
+            let x: f64 = t[..4].iter().map(|&v| m.nodes[v as usize][0]).sum();
+            if x > 0.0 || one_region {
+                1
+            } else {
+                2
+            }
+        })
+        .collect();
+    let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+    const EDGES: [(usize, usize); 6] = [(0, 1), (1, 2), (2, 0), (3, 0), (3, 2), (3, 1)];
+    for t in &m.tets {
+        for (k, &(i, j)) in EDGES.iter().enumerate() {
+            mid.insert((t[i].min(t[j]), t[i].max(t[j])), t[4 + k]);
+        }
+    }
+    // Faces by sorted corners -> the tets holding them.
+    let mut faces: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    for (ti, t) in m.tets.iter().enumerate() {
+        for f in [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]] {
+            let mut k = [t[f[0]], t[f[1]], t[f[2]]];
+            k.sort_unstable();
+            faces.entry(k).or_default().push(ti);
+        }
+    }
+    let x_centroid = |t: usize| -> bool {
+        let x: f64 = m.tets[t][..4].iter().map(|&v| m.nodes[v as usize][0]).sum();
+        x > 0.0
+    };
+    let mut interface: Vec<[u32; 6]> = faces
+        .iter()
+        .filter(|(_, ts)| ts.len() == 2 && x_centroid(ts[0]) != x_centroid(ts[1]))
+        .map(|(k, _)| {
+            let e = |a: u32, b: u32| mid[&(a.min(b), a.max(b))];
+            [
+                k[0],
+                k[1],
+                k[2],
+                e(k[0], k[1]),
+                e(k[1], k[2]),
+                e(k[2], k[0]),
+            ]
+        })
+        .collect();
+    interface.sort_unstable();
+    let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n");
+    writeln!(s, "{}", m.nodes.len()).unwrap();
+    for (i, p) in m.nodes.iter().enumerate() {
+        writeln!(s, "{} {:?} {:?} {:?}", i + 1, p[0], p[1], p[2]).unwrap();
+    }
+    let n = m.boundary.len() + interface.len() + m.tets.len();
+    write!(s, "$EndNodes\n$Elements\n{n}\n").unwrap();
+    let mut id = 0;
+    let mut element = |s: &mut String, ty: u32, tag: i32, nodes: &[u32]| {
+        id += 1;
+        write!(s, "{id} {ty} 2 {tag} {tag}").unwrap();
+        for v in nodes {
+            write!(s, " {}", v + 1).unwrap();
+        }
+        s.push('\n');
+    };
+    for b in &m.boundary {
+        element(&mut s, 9, 1, b);
+    }
+    for b in &interface {
+        element(&mut s, 9, 9, b);
+    }
+    for (t, r) in m.tets.iter().zip(&region) {
+        element(&mut s, 11, *r, t);
+    }
+    s.push_str("$EndElements\n");
+    std::fs::write(path, s).unwrap();
+    interface.len()
+}
+
+/// Issue 30: `check` accepts a conforming two-region mesh whose interface triangles are
+/// listed with the boundary, reports the regions, and still refuses such triangles
+/// inside one region (a cavity filled with tets would look the same).
+#[test]
+fn check_accepts_two_regions_with_their_interface() {
+    let two = tmp("two_regions.msh");
+    let k = two_region_sphere(&two, false);
+    assert!(k > 50, "{k} interface triangles");
+    let out = run(&["check", two.to_str().unwrap(), "--json"]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(j["valid"], true);
+    assert_eq!(j["conformity"]["interface_faces"], k);
+    let regions: Vec<i64> = j["regions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["tag"].as_i64().unwrap())
+        .collect();
+    assert_eq!(regions, vec![1, 2]);
+    let text = run(&["check", two.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains(&format!("{k} interface triangles")));
+
+    let one = tmp("one_region_interface.msh");
+    two_region_sphere(&one, true);
+    let out = run(&["check", one.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(6));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("is not a face of one tet"), "{err}");
+}
+
+/// Issue 30: the CLI's outputs carry what the other doors do. Its .vtu and .vtk meshes
+/// have the per-tet `ScaledJacobian` and `EquiangularSkewness` cell arrays (as the VTK
+/// filter's output; meshio reads them, and their extremes are the report's); its
+/// `--report` has the crate version, the options used and per-stage times including
+/// reading and writing.
+#[test]
+fn cli_vtu_has_quality_arrays_and_report_has_version_options_times() {
+    let vtu = tmp("quality.vtu");
+    let vtk = tmp("quality.vtk");
+    let report = tmp("quality.json");
+    let out = run(&[
+        "mesh",
+        data("sphere_lin.off").to_str().unwrap(),
+        "-o",
+        vtu.to_str().unwrap(),
+        "--report",
+        report.to_str().unwrap(),
+        "--alpha",
+        "1.4",
+        "-q",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["curvetet_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(r["options"]["alpha"], 1.4);
+    assert_eq!(r["options"]["size"], "graded");
+    assert_eq!(r["options"]["optimize"], true);
+    assert_eq!(r["input"]["feature_angle"], 40.0);
+    assert!(r["input"]["path"]
+        .as_str()
+        .unwrap()
+        .ends_with("sphere_lin.off"));
+    for stage in [
+        "read",
+        "size_field",
+        "front",
+        "assemble",
+        "optimize",
+        "certify",
+        "report",
+        "write",
+    ] {
+        let t = r["times"][stage].as_f64().unwrap_or(-1.0);
+        assert!(t > 0.0, "{stage}: {}", r["times"]);
+    }
+    let out = run(&["convert", vtu.to_str().unwrap(), vtk.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let min_sj = r["report"]["quality"]["scaled_jacobian"]["min"]
+        .as_f64()
+        .unwrap();
+    let max_skew = r["report"]["quality"]["skewness"]["max"].as_f64().unwrap();
+    let ntets = r["report"]["num_tets"].as_u64().unwrap();
+    let script = r#"
+import sys, json
+import numpy as np
+import meshio
+for path in sys.argv[1:]:
+    m = meshio.read(path)
+    sj = np.concatenate([d for b, d in zip(m.cells, m.cell_data["ScaledJacobian"]) if b.type == "tetra10"])
+    sk = np.concatenate([d for b, d in zip(m.cells, m.cell_data["EquiangularSkewness"]) if b.type == "tetra10"])
+    print(json.dumps([len(sj), float(sj.min()), float(sj.max()), float(sk.max())]))
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script, vtu.to_str().unwrap(), vtk.to_str().unwrap()])
+        .output()
+        .expect("python3 runs (scripts/install-deps installs meshio)");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    for line in lines {
+        let v: Vec<f64> = serde_json::from_str(line).unwrap();
+        assert_eq!(v[0] as u64, ntets);
+        // The .vtk holds 17 significant digits, as the .vtu.
+        assert!(
+            (v[1] - min_sj).abs() <= 1e-12 * min_sj,
+            "{v:?} vs min SJ {min_sj}"
+        );
+        assert!(v[2] <= 1.0 + 1e-12, "{v:?}");
+        assert!(
+            (v[3] - max_skew).abs() <= 1e-12,
+            "{v:?} vs max skewness {max_skew}"
+        );
+    }
+}
+
+/// Issue 30: the progress callback (and so the CLI's progress bar) reports an optimize
+/// stage between the front and the certification, and none when optimization is off.
+#[test]
+fn progress_reports_the_optimize_stage() {
+    let raw = curvetet::io::read(&data("sphere_p2.msh")).unwrap();
+    let surface = curvetet::io::surface_from_raw(raw, "sphere").unwrap();
+    for optimize in [true, false] {
+        let opts = curvetet::Options {
+            optimize,
+            ..Default::default()
+        };
+        let mut stages: Vec<(String, f64)> = Vec::new();
+        curvetet::generate_with_progress(&surface, &opts, &mut |f, s| {
+            if stages.last().map(|x| x.0.as_str()) != Some(s) || s == "optimize" {
+                stages.push((s.to_string(), f));
+            }
+            false
+        })
+        .unwrap();
+        let names: Vec<&str> = stages.iter().map(|s| s.0.as_str()).collect();
+        if optimize {
+            assert_eq!(
+                names,
+                ["front", "optimize", "optimize", "certify"],
+                "{stages:?}"
+            );
+            assert_eq!((stages[1].1, stages[2].1), (0.0, 0.5));
+        } else {
+            assert_eq!(names, ["front", "certify"], "{stages:?}");
+        }
+    }
+}

@@ -127,6 +127,7 @@ fn curved_mesh() -> TetMesh {
         tets,
         boundary,
         boundary_tags: vec![4, 7, 4, 2, 7, 9],
+        groups: Default::default(),
     }
 }
 
@@ -334,25 +335,37 @@ fn round_trip_surface_only() {
     }
 }
 
+/// Every boundary part is a group with a positive number in every format (issue 30):
+/// positive tags are kept, 0 and then -3 take the first free numbers, 1 and 2.
 #[test]
-fn non_positive_tags_get_their_own_msh_entities() {
+fn non_positive_tags_get_free_positive_groups() {
     let mut mesh = curved_mesh();
     mesh.boundary_tags = vec![0, 5, -3, 5, 0, 5];
+    let want = vec![1, 5, 2, 5, 1, 5];
     for ver in [MshVersion::V41, MshVersion::V22] {
-        let opts = WriteOptions {
-            msh_version: ver,
-            ..Default::default()
-        };
-        let bytes = mesh_to_bytes(&mesh, Format::Msh, &opts).unwrap();
-        let back = read_bytes(&bytes, Format::Msh, "t.msh").unwrap();
-        // Positive tags survive; 0 and -3 become fresh entity tags 6 and 7 (sorted).
-        assert_eq!(back.tri6_tags, vec![7, 5, 6, 5, 7, 5], "{ver:?}");
+        for binary in [false, true] {
+            let opts = WriteOptions {
+                msh_version: ver,
+                binary,
+                ..Default::default()
+            };
+            let bytes = mesh_to_bytes(&mesh, Format::Msh, &opts).unwrap();
+            let back = read_bytes(&bytes, Format::Msh, "t.msh").unwrap();
+            assert_eq!(back.tri6_tags, want, "{ver:?} binary {binary}");
+            // Tag 0 is the group named `boundary`, the volume `volume`.
+            let names: Vec<_> = back
+                .physical_names
+                .iter()
+                .map(|n| (n.dim, n.tag, n.name.as_str()))
+                .collect();
+            assert_eq!(names, vec![(2, 1, "boundary"), (3, 1, "volume")]);
+            assert!(back.tet10_tags.iter().all(|&t| t == 1));
+        }
     }
-    // VTK and medit keep any tag.
     for f in [Format::Vtu, Format::Vtk, Format::Medit] {
         let bytes = mesh_to_bytes(&mesh, f, &WriteOptions::default()).unwrap();
         let back = read_bytes(&bytes, f, "t").unwrap();
-        assert_eq!(back.tri6_tags, mesh.boundary_tags, "{f:?}");
+        assert_eq!(back.tri6_tags, want, "{f:?}");
     }
 }
 
@@ -992,9 +1005,45 @@ for mode, name in [("ascii", "vtk_ascii.vtu"), ("binary", "vtk_binary.vtu")]:
     w.SetDataModeToAscii() if mode == "ascii" else w.SetDataModeToBinary()
     w.SetFileName(outdir + "/" + name)
     assert w.Write() == 1
+# The writer's default (appended raw data, zlib), and the other encodings, compressors,
+# header types; small blocks so that arrays span several.
+def xml(name, setup):
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetInputData(r.GetOutput())
+    setup(w)
+    w.SetFileName(outdir + "/" + name)
+    assert w.Write() == 1
+xml("vtk_default.vtu", lambda w: None)
+head = open(outdir + "/vtk_default.vtu", "rb").read(4000)
+assert b'format="appended"' in head and b"vtkZLibDataCompressor" in head, head
+assert b'encoding="base64"' in head, head
+def appended_raw(w):
+    w.EncodeAppendedDataOff()
+    w.SetBlockSize(64)
+xml("vtk_appended_raw.vtu", appended_raw)
+def lz4_32(w):
+    w.SetCompressorTypeToLZ4()
+    w.EncodeAppendedDataOff()
+    w.SetHeaderTypeToUInt32()
+    w.SetBlockSize(64)
+xml("vtk_lz4_u32.vtu", lz4_32)
+def inline_zlib_64(w):
+    w.SetDataModeToBinary()
+    w.SetHeaderTypeToUInt64()
+    w.SetBlockSize(64)
+xml("vtk_inline_zlib_u64.vtu", inline_zlib_64)
+def appended_plain(w):
+    w.SetCompressorTypeToNone()
+    w.EncodeAppendedDataOff()
+xml("vtk_appended_plain.vtu", appended_plain)
 w = vtk.vtkUnstructuredGridWriter()
 w.SetInputData(r.GetOutput())
 w.SetFileName(outdir + "/vtk_legacy.vtk")
+assert w.Write() == 1
+w = vtk.vtkUnstructuredGridWriter()
+w.SetInputData(r.GetOutput())
+w.SetFileTypeToBinary()
+w.SetFileName(outdir + "/vtk_legacy_binary.vtk")
 assert w.Write() == 1
 assert log.GetOutput() == "", log.GetOutput()
 print("vtk ok")
@@ -1036,8 +1085,17 @@ fn vtk_reads_what_we_write_and_we_read_what_vtk_writes() {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    for file in ["vtk_ascii.vtu", "vtk_binary.vtu"] {
-        let back = io::read(&dir.join(file)).unwrap();
+    for file in [
+        "vtk_ascii.vtu",
+        "vtk_binary.vtu",
+        "vtk_default.vtu",
+        "vtk_appended_raw.vtu",
+        "vtk_lz4_u32.vtu",
+        "vtk_inline_zlib_u64.vtu",
+        "vtk_appended_plain.vtu",
+        "vtk_legacy_binary.vtk",
+    ] {
+        let back = io::read(&dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert_same_geometry(file, &mesh, &back, 0);
     }
     // VTK's legacy writer (5.1 layout) prints 11 significant digits.
@@ -1064,6 +1122,11 @@ meshio.write(outdir + "/mio22b.msh", m, file_format="gmsh22", binary=True)
 meshio.write(outdir + "/mio_b.vtu", m, binary=True, compression=None)
 meshio.write(outdir + "/mio_a.vtu", m, binary=False)
 meshio.write(outdir + "/mio_a.vtk", m, binary=False)
+# meshio's defaults: binary, zlib-compressed; and a UInt64 header; binary legacy VTK.
+meshio.write(outdir + "/mio_default.vtu", m)
+assert b"vtkZLibDataCompressor" in open(outdir + "/mio_default.vtu", "rb").read(2000)
+meshio.write(outdir + "/mio_zlib64.vtu", m, header_type="UInt64")
+meshio.write(outdir + "/mio_b.vtk", m, binary=True)
 "#;
 
 /// Files meshio writes (from a surface we wrote) read back as the same surface.
@@ -1097,6 +1160,9 @@ fn we_read_what_meshio_writes() {
         "mio_b.vtu",
         "mio_a.vtu",
         "mio_a.vtk",
+        "mio_default.vtu",
+        "mio_zlib64.vtu",
+        "mio_b.vtk",
     ] {
         let back = io::read(&dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert_eq!(back.tri6, s.tri6, "{file}");
@@ -1256,4 +1322,31 @@ fn skip(why: &str) {
         panic!("required tool missing: {why}");
     }
     println!("note: {why}");
+}
+
+/// The checked-in files VTK and meshio wrote (fuzz/seeds, from `fuzz/make-seeds`): VTK's
+/// XML writer's default (appended base64, zlib), raw appended zlib and LZ4 (UInt32
+/// header), inline zlib (UInt64 header) in blocks of 256 bytes, meshio's default (inline
+/// zlib), and both tools' binary legacy VTK, read as the same mesh as our own ASCII .vtu
+/// (without Python installed).
+#[test]
+fn checked_in_vtk_and_meshio_files_read_as_ours() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
+    let ours = io::read(&seeds.join("read_vtu/ico_tets.vtu")).unwrap();
+    assert!(!ours.tet10.is_empty() && !ours.tri6.is_empty());
+    for file in [
+        "read_vtu/ico_tets_vtk_default.vtu",
+        "read_vtu/ico_tets_vtk_raw_zlib.vtu",
+        "read_vtu/ico_tets_vtk_raw_lz4_u32.vtu",
+        "read_vtu/ico_tets_vtk_inline_zlib_u64.vtu",
+        "read_vtu/ico_tets_meshio_default.vtu",
+        "read_vtk/ico_tets_vtk_binary.vtk",
+        "read_vtk/ico_tets_meshio_binary.vtk",
+    ] {
+        let back = io::read(&seeds.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_eq!(back.nodes, ours.nodes, "{file}");
+        assert_eq!(back.tet10, ours.tet10, "{file}");
+        assert_eq!(back.tri6, ours.tri6, "{file}");
+        assert_eq!(back.tri6_tags, ours.tri6_tags, "{file}");
+    }
 }

@@ -96,6 +96,7 @@ fn small_mesh() -> TetMesh {
             [1, 2, 3, 5, 8, 9],
         ],
         boundary_tags: vec![1, 2, 3, 3],
+        groups: Default::default(),
     }
 }
 
@@ -114,6 +115,7 @@ fn written_files() -> Vec<(String, Format, Vec<u8>, usize)> {
         tets: vec![],
         boundary: s.tri6,
         boundary_tags: s.tri6_tags,
+        groups: Default::default(),
     };
     let mut out = Vec::new();
     for (mname, m) in [("tet", &mesh), ("sphere", &big)] {
@@ -426,11 +428,11 @@ fn unsupported_variants_say_so() {
     for (f, b, want) in [
         (Format::Msh, &b"$MeshFormat\n4 0 8\n$EndMeshFormat\n"[..], "4.0 is not supported"),
         (Format::Msh, b"$MeshFormat\n3 0 8\n$EndMeshFormat\n", "unsupported MSH version"),
-        (Format::Vtk, b"# vtk DataFile Version 4.2\nx\nBINARY\n", "binary legacy VTK"),
+        (Format::Vtk, b"# vtk DataFile Version 4.2\nx\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 1 bit\n", "data type 'bit' is not supported in a binary file"),
         (Format::Vtk, b"# vtk DataFile Version 4.2\nx\nASCII\nDATASET POLYDATA\n", "only UNSTRUCTURED_GRID"),
         (Format::Vtu, b"<VTKFile type=\"PolyData\"></VTKFile>", "only UnstructuredGrid"),
-        (Format::Vtu, b"<VTKFile type=\"UnstructuredGrid\" compressor=\"vtkZLibDataCompressor\"><UnstructuredGrid><Piece NumberOfPoints=\"1\" NumberOfCells=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">AAAA</DataArray></Points></Piece></UnstructuredGrid></VTKFile>", "compressed"),
-        (Format::Vtu, b"<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"1\" NumberOfCells=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece></UnstructuredGrid><AppendedData encoding=\"raw\">_\x00<\xff</AppendedData></VTKFile>", "appended"),
+        (Format::Vtu, b"<VTKFile type=\"UnstructuredGrid\" compressor=\"vtkLZMADataCompressor\"><UnstructuredGrid><Piece NumberOfPoints=\"1\" NumberOfCells=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"binary\">AAAA</DataArray></Points></Piece></UnstructuredGrid></VTKFile>", "compressor 'vtkLZMADataCompressor' is not supported"),
+        (Format::Vtu, b"<VTKFile type=\"UnstructuredGrid\"><UnstructuredGrid><Piece NumberOfPoints=\"1\" NumberOfCells=\"0\"><Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points></Piece></UnstructuredGrid><AppendedData encoding=\"raw\">_\x00<\xff</AppendedData></VTKFile>", "declares 1023360000 bytes but holds"),
         (Format::Medit, b"MeshVersionFormatted 2\nDimension 3\nVertices\n0\nTetrahedraP2Ordering\n10\n", "Ordering sections"),
     ] {
         let e = expect_err(b, f, want);
@@ -449,4 +451,40 @@ fn deeply_nested_xml_is_an_error_without_a_large_allocation() {
     let e = expect_err(&b, Format::Vtu, "unclosed tags");
     assert!(e.contains("nested more than 64 deep"), "{e}");
     assert_small_allocations();
+}
+
+/// Every prefix of the binary files other tools write (VTK's appended raw zlib and LZ4
+/// .vtu, inline zlib .vtu, binary legacy .vtk; checked-in fuzz seeds) is an error or, when
+/// only the closing tags (or a legacy file's optional cell data) are cut, the whole mesh:
+/// never a panic or a different mesh.
+#[test]
+fn prefixes_of_compressed_and_binary_vtk_files_fail_cleanly() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds");
+    for (file, f) in [
+        ("read_vtu/ico_tets_vtk_raw_zlib.vtu", Format::Vtu),
+        ("read_vtu/ico_tets_vtk_raw_lz4_u32.vtu", Format::Vtu),
+        ("read_vtu/ico_tets_vtk_default.vtu", Format::Vtu),
+        ("read_vtu/ico_tets_meshio_default.vtu", Format::Vtu),
+        ("read_vtk/ico_tets_vtk_binary.vtk", Format::Vtk),
+    ] {
+        let bytes = std::fs::read(seeds.join(file)).unwrap();
+        let full = curvetet::io::read_bytes(&bytes, f, "input").unwrap();
+        let mut errors = 0;
+        for n in 0..bytes.len() {
+            match curvetet::io::read_bytes(&bytes[..n], f, "input") {
+                Ok(m) => {
+                    assert_eq!(m.nodes, full.nodes, "{file}: prefix of {n} bytes");
+                    assert_eq!(m.tri6, full.tri6, "{file}: prefix of {n} bytes");
+                    assert_eq!(m.tet10, full.tet10, "{file}: prefix of {n} bytes");
+                }
+                Err(_) => errors += 1,
+            }
+        }
+        // All but the prefixes that cut only the closing tags or cell data fail.
+        assert!(
+            errors + 256 >= bytes.len(),
+            "{file}: {errors} of {}",
+            bytes.len()
+        );
+    }
 }

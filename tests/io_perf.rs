@@ -83,6 +83,7 @@ fn grid_mesh(n: usize) -> TetMesh {
         tets,
         boundary,
         boundary_tags,
+        groups: Default::default(),
     }
 }
 

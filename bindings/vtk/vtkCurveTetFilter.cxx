@@ -184,12 +184,16 @@ int vtkCurveTetFilter::ProgressCallback(void* user, double fraction, const char*
 {
   auto* self = static_cast<vtkCurveTetFilter*>(user);
   // curvetet's stages: "front" (most of the time; "front (attempt 2 of 4)" and so on
-  // when it starts again, from 0), then "certify"; the optimization and the copy into VTK
-  // take the rest. Progress shown never goes back.
+  // when it starts again, from 0), "optimize" (0, then 0.5), then "certify"; the copy
+  // into VTK takes the rest. Progress shown never goes back.
   double p = self->LastProgress;
   if (stage && std::strncmp(stage, "front", 5) == 0)
   {
-    p = 0.05 + 0.8 * fraction;
+    p = 0.05 + 0.7 * fraction;
+  }
+  else if (stage && std::strcmp(stage, "optimize") == 0)
+  {
+    p = 0.75 + 0.1 * fraction;
   }
   else if (stage && std::strcmp(stage, "certify") == 0)
   {

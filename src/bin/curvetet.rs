@@ -257,6 +257,8 @@ impl WriteArgs {
                 MshVersion::V41
             },
             binary: self.binary,
+            // The VTK filter's per-tet quality arrays, in .vtu and .vtk meshes.
+            quality_arrays: true,
             ..WriteOptions::default()
         }
     }
@@ -416,7 +418,44 @@ fn progress_bar(quiet: bool) -> ProgressBar {
     pb
 }
 
-fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Error> {
+/// The options a mesh was made and written with, for `--report`.
+fn options_json(o: &Options, w: &WriteOptions) -> serde_json::Value {
+    serde_json::json!({
+        "alpha": o.alpha,
+        "size": match o.size {
+            SizeMode::Graded => serde_json::json!("graded"),
+            SizeMode::Uniform => serde_json::json!("uniform"),
+            SizeMode::Fixed(h) => serde_json::json!(h),
+        },
+        "size_from": o.size_from,
+        "gradation": o.gradation,
+        "optimize": o.optimize,
+        "thorough": o.thorough,
+        "threads": o.threads,
+        "min_dihedral_deg": o.min_dihedral_deg,
+        "max_skewness": o.max_skewness,
+        "min_edge_face_angle_deg": o.min_edge_face_angle_deg,
+        "msh_version": match w.msh_version {
+            MshVersion::V41 => "4.1",
+            MshVersion::V22 => "2.2",
+        },
+        "binary": w.binary,
+    })
+}
+
+/// Where the surface came from and how long reading (and curving) it took, for
+/// `--report`.
+struct InputInfo {
+    json: serde_json::Value,
+    read_seconds: f64,
+}
+
+fn run_mesh(
+    surface: &Surface,
+    m: &MeshOptions,
+    output: &Path,
+    input: InputInfo,
+) -> Result<(), Error> {
     for w in surface.warnings() {
         eprintln!("warning: {w}");
     }
@@ -460,7 +499,9 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
             return Err(e);
         }
     };
+    let t = std::time::Instant::now();
     io::write_mesh(output, &g.mesh, &m.write.options())?;
+    let write_seconds = t.elapsed().as_secs_f64();
     let r = &g.report;
     eprintln!(
         "{} tets, {} nodes in {:.3} s (front {:.3} s); min scaled Jacobian {:.3} (certified {:.3}), max skewness {:.3}, dihedral {:.1}..{:.1} deg",
@@ -479,11 +520,19 @@ fn run_mesh(surface: &Surface, m: &MeshOptions, output: &Path) -> Result<(), Err
         write_plot(p, r, &output.display().to_string())?;
     }
     if let Some(path) = &m.report {
+        let mut times =
+            serde_json::to_value(&g.times).map_err(|e| Error::InvalidArgument(e.to_string()))?;
+        times["read"] = input.read_seconds.into();
+        times["write"] = write_seconds.into();
         let json = serde_json::json!({
+            "curvetet_version": env!("CARGO_PKG_VERSION"),
+            "input": input.json,
+            "output": output.display().to_string(),
+            "options": options_json(&opts, &m.write.options()),
             "input_triangles": surface.triangles().len(),
             "report": r,
             "front": g.front,
-            "times": g.times,
+            "times": times,
             "optimize": g.optimize,
             "size": g.size,
             "size_from": g.size_from,
@@ -514,7 +563,9 @@ fn curve_raw(raw: io::RawMesh, name: &str, c: &CurveArgs) -> Result<(Surface, Cu
         return io::surface_from_raw_any(raw, name, &c.options())
             .map(|s| (s, CurveReport::default()));
     }
-    curve_linear_report(raw.nodes, raw.tri3, raw.tri3_tags, &c.options())
+    let groups = raw.groups();
+    let (s, r) = curve_linear_report(raw.nodes, raw.tri3, raw.tri3_tags, &c.options())?;
+    Ok((s.with_groups(groups), r))
 }
 
 fn curve_summary(name: &str, s: &Surface, r: &CurveReport) -> String {
@@ -621,8 +672,17 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     }
     // The surface checks (parallel) run on as many threads as the meshing: `--threads 1`
     // is one thread from start to end.
+    let t = std::time::Instant::now();
     let surface = curvetet::threads::pool(a.mesh.threads, true)?
         .install(|| read_surface_any(&a.input, &a.curve))?;
+    let input = InputInfo {
+        json: serde_json::json!({
+            "path": a.input.display().to_string(),
+            "feature_angle": a.curve.feature_angle,
+            "smooth": a.curve.smooth,
+        }),
+        read_seconds: t.elapsed().as_secs_f64(),
+    };
     if let Some((budget, what)) = &budget {
         let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
         if need > *budget {
@@ -635,7 +695,7 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
             )));
         }
     }
-    run_mesh(&surface, &a.mesh, &a.output)
+    run_mesh(&surface, &a.mesh, &a.output, input)
 }
 
 fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
@@ -708,7 +768,11 @@ fn cmd_demo(
         )?;
         eprintln!("wrote {}", p.display());
     }
-    run_mesh(&surface, m, output)
+    let input = InputInfo {
+        json: serde_json::json!({"demo": "torus", "R": big_r, "r": r, "triangles": n}),
+        read_seconds: 0.0,
+    };
+    run_mesh(&surface, m, output, input)
 }
 
 fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> {
@@ -844,8 +908,19 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
         }
         return Ok(());
     }
+    // Region ids: the tets' tags, when they are not all one.
+    let regions = if raw.tet10_tags.windows(2).any(|w| w[0] != w[1]) {
+        raw.tet10_tags.clone()
+    } else {
+        Vec::new()
+    };
+    let region_counts: std::collections::BTreeMap<i32, usize> =
+        raw.tet10_tags.iter().fold(Default::default(), |mut c, &t| {
+            *c.entry(t).or_default() += 1;
+            c
+        });
     let m: TetMesh = raw.into_tet_mesh()?;
-    let conf = check::check_conformity(&m)?;
+    let conf = check::check_conformity_regions(&m, &regions)?;
     let report = QualityReport::of(&m);
     if let Some(p) = plot {
         write_plot(p, &report, &name)?;
@@ -855,6 +930,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
     if json {
         let j = serde_json::json!({
             "kind": "volume", "file": name, "valid": ok, "conformity": conf,
+            "regions": region_counts.iter().map(|(t, n)| serde_json::json!({"tag": t, "tets": n})).collect::<Vec<_>>(),
             "volume_relative_difference": rel, "report": report,
         });
         say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
@@ -874,6 +950,17 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
             "  conforming: {} interior faces shared by two tets, boundary closed",
             conf.interior_faces
         )?;
+        if region_counts.len() > 1 {
+            let list: Vec<String> = region_counts
+                .iter()
+                .map(|(t, n)| format!("{t} ({n} tets)"))
+                .collect();
+            say!(
+                "  regions: {}; {} interface triangles between them",
+                list.join(", "),
+                conf.interface_faces
+            )?;
+        }
         say!("  volume: tets {:.12}, enclosed by the linear boundary {:.12} (rel. diff. {rel:.1e}); curved {:.12}", conf.volume_linear, conf.enclosed_linear, report.volume_curved)?;
         say!("  certified-invalid elements: {}", report.num_invalid)?;
         say!(

@@ -453,6 +453,7 @@ unsafe fn write_impl(
             },
             binary: flags & CURVETET_WRITE_BINARY != 0,
             medit_linear: flags & CURVETET_WRITE_MEDIT_LINEAR != 0,
+            ..WriteOptions::default()
         };
         crate::io::write_mesh(&path, &m.generated.mesh, &opts)?;
         Ok(())

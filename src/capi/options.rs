@@ -21,7 +21,8 @@ use std::mem::{align_of, offset_of, size_of};
 /// Progress callback: called from the thread that called `curvetet_generate`, with the
 /// fraction of the work done (0..1, non-decreasing within a stage) and a short stage
 /// name ("front"; "front (attempt 2 of 4)" and so on when the front starts again with
-/// another configuration, its fraction from 0; "certify"; the string is valid only during
+/// another configuration, its fraction from 0; "optimize" (0 and 0.5: the linear and the
+/// high-order stage) unless optimization is off; "certify"; the string is valid only during
 /// the call). Return nonzero
 /// to cancel: `curvetet_generate` then returns `CURVETET_ERR_CANCELLED` promptly. It must
 /// not unwind (throw a C++ exception or `longjmp`) through curvetet.

@@ -11,11 +11,16 @@ use std::io::{self, Write};
 use super::cursor::{capped, show, Cursor};
 use super::order::{self, Convention};
 use super::text_out::{int, point, uint};
-use super::{MeshView, RawMesh, VOLUME_TAG};
+use super::{MeshView, RawMesh};
 use crate::error::Result;
 
 /// Write an ASCII medit file (double precision, `MeshVersionFormatted 2`).
-pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView, linear: bool) -> io::Result<()> {
+pub(crate) fn write<W: Write>(
+    w: &mut W,
+    view: &MeshView,
+    volume_tag: i32,
+    linear: bool,
+) -> io::Result<()> {
     w.write_all(b"MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n")?;
     uint(w, view.nodes.len() as u64)?;
     w.write_all(b"\n")?;
@@ -54,7 +59,7 @@ pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView, linear: bool) -> io::R
         w.write_all(b"\n")?;
         for t in view.tet10 {
             let t = order::tet10_to(Convention::Medit, t);
-            record(w, if linear { &t[..4] } else { &t }, VOLUME_TAG)?;
+            record(w, if linear { &t[..4] } else { &t }, volume_tag)?;
         }
     }
     w.write_all(b"\nEnd\n")

@@ -4,8 +4,8 @@
 //! | format | read | write |
 //! |---|---|---|
 //! | `.msh` | 2.2 (also 2.0/2.1) and 4.1, ASCII and binary, either endianness | 4.1 (default) or 2.2, ASCII (default) or binary |
-//! | `.vtu` | ASCII and inline base64 `binary` arrays (UInt32/UInt64 header, uncompressed) | ASCII (default) or inline base64 binary |
-//! | `.vtk` | legacy ASCII `UNSTRUCTURED_GRID`, classic and 5.x `CELLS` layouts | legacy ASCII (version 4.2 layout) |
+//! | `.vtu` | ASCII, inline base64 `binary` and `appended` (raw or base64) arrays; UInt32/UInt64 header; uncompressed, zlib or LZ4 | ASCII (default) or inline base64 binary |
+//! | `.vtk` | legacy ASCII and BINARY `UNSTRUCTURED_GRID`, classic and 5.x `CELLS` layouts | legacy ASCII (version 4.2 layout) |
 //! | `.mesh` | ASCII medit (`Triangles`, `TrianglesP2`, `Tetrahedra`, `TetrahedraP2`) | ASCII medit, P2 (default) or linear |
 //! | `.stl` | ASCII and binary (3-node triangles, vertices welded exactly) | — |
 //! | `.off` | ASCII OFF and its COFF/NOFF/... variants, polygons split as fans | — |
@@ -25,17 +25,22 @@
 //! reserve more memory than the file's size justifies.
 //!
 //! What the writers put in a file:
-//! - `.msh`: one surface entity per distinct boundary tag, each in a physical group whose
-//!   tag is that boundary tag (so the tags read back unchanged), and one volume entity in
-//!   physical group [`VOLUME_TAG`]. A Gmsh physical tag must be positive: triangles with a
-//!   tag <= 0 are written on their own surface entity without a physical group, and read
-//!   back with that entity's tag (a fresh positive number).
+//! Every boundary part and the volume is a physical group with a positive number (see
+//! [`Groups`]): a positive triangle tag is its own group's number (so tags read back
+//! unchanged); tags <= 0 take the first free numbers (untagged triangles, tag 0, become
+//! group 1 named `boundary` when 1 is free); the volume's number is
+//! [`Groups::volume_tag`] (the input's, default [`VOLUME_TAG`]).
+//! - `.msh`: one surface entity per group, in that physical group; one volume entity in
+//!   the volume's group; `$PhysicalNames` with the input's names, `boundary` for the
+//!   untagged triangles and `volume` for an unnamed volume.
 //! - `.vtu`/`.vtk`: one unstructured grid holding both the tetrahedra (type 24) and the
 //!   boundary triangles (type 22), with an Int32 cell array `BoundaryTag` that holds each
-//!   triangle's tag and 0 for the tetrahedra (ParaView and meshio read mixed cells; use a
-//!   Threshold on the cell type or the tag to see one or the other).
-//! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = tag, and
-//!   `TetrahedraP2` with reference [`VOLUME_TAG`], in the order established in [`order`];
+//!   triangle's group number and 0 for the tetrahedra (ParaView and meshio read mixed
+//!   cells; use a Threshold on the cell type or the tag to see one or the other); a
+//!   `.vtu` names the groups in field data arrays (name -> (number, dimension)), read back
+//!   into [`RawMesh::physical_names`].
+//! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = group number, and
+//!   `TetrahedraP2` with the volume's number, in the order established in [`order`];
 //!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
 //!   instead (for meshio, MMG, TetGen, which do not read the P2 sections).
 
@@ -48,6 +53,7 @@ use crate::mesh::TetMesh;
 
 mod atomic;
 mod cursor;
+mod groups;
 mod linear;
 mod lines;
 mod medit;
@@ -64,10 +70,12 @@ mod text_out;
 mod vtk;
 mod vtk_cells;
 mod vtu;
+mod vtu_data;
 mod vtu_write;
 mod weld;
 
 pub use atomic::{check_output_dir, remove_unfinished_temporaries, same_file, write_atomic};
+pub use groups::{Groups, PhysicalName, DEFAULT_VOLUME_NAME, UNTAGGED_BOUNDARY_NAME};
 pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
@@ -102,9 +110,33 @@ pub struct RawMesh {
     pub tet10_tags: Vec<i32>,
     /// Elements of other kinds (points, lines, quads, ...) that were skipped.
     pub ignored_elements: u64,
+    /// Named physical groups (Gmsh `$PhysicalNames`), in file order.
+    pub physical_names: Vec<PhysicalName>,
 }
 
 impl RawMesh {
+    /// The volume's tag and the group names: the tag of the first 10-node (else 4-node)
+    /// tetrahedron when positive; else (a surface, or tets tagged 0 as in a .vtu) the
+    /// only named volume group if there is exactly one; else [`VOLUME_TAG`].
+    pub fn groups(&self) -> Groups {
+        let from_tets = self
+            .tet10_tags
+            .first()
+            .or(self.tet4_tags.first())
+            .copied()
+            .filter(|&t| t > 0);
+        let mut volumes = self.physical_names.iter().filter(|n| n.dim == 3);
+        let named = match (volumes.next(), volumes.next()) {
+            (Some(n), None) if n.tag > 0 => Some(n.tag),
+            _ => None,
+        };
+        let tets = !self.tet10_tags.is_empty() || !self.tet4_tags.is_empty();
+        Groups {
+            volume_tag: if tets { from_tets.or(named) } else { named }.unwrap_or(VOLUME_TAG),
+            names: self.physical_names.clone(),
+        }
+    }
+
     /// The P2 mesh in it: nodes, 10-node tets and 6-node boundary triangles with tags.
     ///
     /// A file with only 3-node triangles is a linear surface:
@@ -126,11 +158,13 @@ impl RawMesh {
                 self.tet4.len()
             )));
         }
+        let groups = self.groups();
         Ok(TetMesh {
             nodes: self.nodes,
             tets: self.tet10,
             boundary: self.tri6,
             boundary_tags: self.tri6_tags,
+            groups,
         })
     }
 }
@@ -302,6 +336,10 @@ pub struct WriteOptions {
     /// For .mesh only: write linear `Triangles` and `Tetrahedra` (corner nodes) instead of
     /// `TrianglesP2` and `TetrahedraP2`, for tools that read only linear medit files.
     pub medit_linear: bool,
+    /// For .vtu and .vtk: add the Float64 cell arrays `ScaledJacobian` (sampled min J /
+    /// max J) and `EquiangularSkewness` of each tetrahedron (0 for the triangles), as the
+    /// VTK filter's output has.
+    pub quality_arrays: bool,
 }
 
 /// What the writers see: a validated P2 mesh or surface.
@@ -310,6 +348,7 @@ pub(crate) struct MeshView<'a> {
     pub tri6: &'a [[u32; 6]],
     pub tags: &'a [i32],
     pub tet10: &'a [[u32; 10]],
+    pub groups: &'a Groups,
 }
 
 impl MeshView<'_> {
@@ -349,17 +388,48 @@ fn write_view<W: Write>(
     view: &MeshView,
     opts: &WriteOptions,
 ) -> std::io::Result<()> {
+    // .msh writes the groups itself (entities, names); the others write each triangle's
+    // physical tag (untagged triangles: the `boundary` group's number, not 0).
+    let has_volume = !view.tet10.is_empty() || view.tri6.is_empty();
+    let groups = groups::Resolved::new(view.tags, view.groups, has_volume);
+    let tags = if format == Format::Msh {
+        Vec::new()
+    } else {
+        groups.triangle_tags(view.tags)
+    };
+    let resolved = MeshView {
+        tags: &tags,
+        ..*view
+    };
+    let quality = (opts.quality_arrays
+        && !view.tet10.is_empty()
+        && matches!(format, Format::Vtu | Format::Vtk))
+    .then(|| tet_quality_arrays(view));
+    let quality = quality.as_deref();
     match format {
         Format::Msh => msh_write::write(w, view, opts),
-        Format::Vtu => vtu_write::write(w, view, opts.binary),
-        Format::Vtk => vtk::write(w, view),
-        Format::Medit => medit::write(w, view, opts.medit_linear),
+        Format::Vtu => vtu_write::write(w, &resolved, &groups.names, quality, opts.binary),
+        Format::Vtk => vtk::write(w, &resolved, quality),
+        Format::Medit => medit::write(w, &resolved, groups.volume, opts.medit_linear),
         // Refused by `check_options` before any byte is written.
         Format::Stl | Format::Off | Format::Obj | Format::Ply => Err(std::io::Error::new(
             std::io::ErrorKind::Unsupported,
             "linear surface formats are read only",
         )),
     }
+}
+
+/// (scaled Jacobian, equiangular skewness) of each tetrahedron.
+fn tet_quality_arrays(view: &MeshView) -> Vec<[f64; 2]> {
+    use rayon::prelude::*;
+    view.tet10
+        .par_iter()
+        .map(|t| {
+            let x: [P3; 10] = std::array::from_fn(|k| view.nodes[t[k] as usize]);
+            let q = crate::geom::quality::tet_quality(&x);
+            [q.scaled_jacobian, q.skewness]
+        })
+        .collect()
 }
 
 /// Can curvetet write `format` with `opts`? The writers check it too; this is for callers
@@ -407,6 +477,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, opts: &WriteOptions) -> Result<()
         tri6: &mesh.boundary,
         tags: &mesh.boundary_tags,
         tet10: &mesh.tets,
+        groups: &mesh.groups,
     };
     write_file(path, &view, opts)
 }
@@ -425,6 +496,7 @@ pub fn write_surface(
         tri6,
         tags,
         tet10: &[],
+        groups: &Groups::default(),
     };
     write_file(path, &view, opts)
 }
@@ -436,6 +508,7 @@ pub fn mesh_to_bytes(mesh: &TetMesh, format: Format, opts: &WriteOptions) -> Res
         tri6: &mesh.boundary,
         tags: &mesh.boundary_tags,
         tet10: &mesh.tets,
+        groups: &mesh.groups,
     };
     check_options(format, opts, &view)?;
     view.validate()?;

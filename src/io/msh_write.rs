@@ -1,58 +1,51 @@
 //! Gmsh .msh writer: 4.1 or 2.2, ASCII or binary (little-endian, `size_t` = 8 bytes).
 //!
-//! Layout (see `io` module docs): one surface entity per distinct boundary tag, in a
-//! physical group of that tag when it is positive; one volume entity in physical group
-//! `VOLUME_TAG`. Node and element order are kept: node `i` has tag `i + 1`, and 4.1
+//! Layout (see `io` module docs): one surface entity per distinct boundary tag, in its own
+//! physical group (the tag itself when positive, else a free number); one volume entity in
+//! the volume's physical group; `$PhysicalNames` for the named groups (see
+//! [`Resolved`]). Node and element order are kept: node `i` has tag `i + 1`, and 4.1
 //! element blocks follow runs of equal tags in the triangle list, so a file read back
 //! gives the same indices.
 
 use std::collections::BTreeMap;
 use std::io::{self, Write};
 
+use super::groups::Resolved;
 use super::order::{self, Convention};
 use super::text_out::{float, int, point, uint};
-use super::{MeshView, MshVersion, WriteOptions, VOLUME_TAG};
+use super::{MeshView, MshVersion, WriteOptions};
 
 const TRI6: i32 = 9;
 const TET10: i32 = 11;
 /// The volume's entity tag.
 const VOLUME_ENTITY: i32 = 1;
 
-/// Surface entities: boundary tag -> (entity tag, physical tag if any).
+/// Surface entities: one per boundary tag, each in its own physical group (see
+/// [`Resolved`]); the entity's tag is its physical tag.
 struct Entities {
-    surfaces: BTreeMap<i32, (i32, Option<i32>)>,
-    /// Each triangle's entity tag.
+    groups: Resolved,
+    /// Each triangle's entity (= physical) tag.
     tri_entity: Vec<i32>,
     has_volume: bool,
 }
 
 impl Entities {
     fn new(view: &MeshView) -> Entities {
-        let mut surfaces = BTreeMap::new();
-        for &t in view.tags {
-            surfaces.entry(t).or_insert((0, None));
-        }
-        let max_pos = surfaces
-            .keys()
-            .copied()
-            .filter(|&t| t > 0)
-            .max()
-            .unwrap_or(0);
-        let mut fresh = max_pos;
-        for (&t, v) in surfaces.iter_mut() {
-            *v = if t > 0 {
-                (t, Some(t))
-            } else {
-                fresh += 1;
-                (fresh, None)
-            };
-        }
-        let tri_entity = view.tags.iter().map(|t| surfaces[t].0).collect();
+        let has_volume = !view.tet10.is_empty() || view.tri6.is_empty();
+        let groups = Resolved::new(view.tags, view.groups, has_volume);
+        let tri_entity = groups.triangle_tags(view.tags);
         Entities {
-            surfaces,
+            groups,
             tri_entity,
-            has_volume: !view.tet10.is_empty() || view.tri6.is_empty(),
+            has_volume,
         }
+    }
+
+    /// The surface entity tags, ascending.
+    fn surfaces(&self) -> Vec<i32> {
+        let mut s: Vec<i32> = self.groups.surface.values().copied().collect();
+        s.sort_unstable();
+        s
     }
 
     /// Each node's entity (dim, tag): the first triangle using it, else the volume (or,
@@ -198,6 +191,24 @@ impl<W: Write> Out<'_, W> {
         }
         self.raw(b"$EndMeshFormat\n")
     }
+    /// `$PhysicalNames` (text even in binary files), when there are names.
+    fn names(&mut self, groups: &Resolved) -> io::Result<()> {
+        if groups.names.is_empty() {
+            return Ok(());
+        }
+        self.raw(b"$PhysicalNames\n")?;
+        uint(self.w, groups.names.len() as u64)?;
+        self.raw(b"\n")?;
+        for n in &groups.names {
+            uint(self.w, n.dim as u64)?;
+            self.raw(b" ")?;
+            int(self.w, n.tag as i64)?;
+            self.raw(b" \"")?;
+            self.raw(n.name.as_bytes())?;
+            self.raw(b"\"\n")?;
+        }
+        self.raw(b"$EndPhysicalNames\n")
+    }
     /// End a binary data run before the `$End...` line.
     fn end_data(&mut self) -> io::Result<()> {
         if self.binary {
@@ -210,27 +221,24 @@ impl<W: Write> Out<'_, W> {
 fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
     let ents = Entities::new(view);
     o.header("4.1")?;
+    o.names(&ents.groups)?;
 
     // $Entities
     o.raw(b"$Entities\n")?;
     o.size(0, b" ")?;
     o.size(0, b" ")?;
-    o.size(ents.surfaces.len() as u64, b" ")?;
+    let surfaces = ents.surfaces();
+    o.size(surfaces.len() as u64, b" ")?;
     o.size(ents.has_volume as u64, b"\n")?;
     let (surf_box, vol_box) = ents.bboxes(view);
-    for &(etag, phys) in ents.surfaces.values() {
+    for &etag in &surfaces {
         let b = surf_box.get(&etag).copied().unwrap_or([0.0; 6]);
         o.int(etag, b" ")?;
         for x in b {
             o.double(x, b" ")?;
         }
-        match phys {
-            Some(p) => {
-                o.size(1, b" ")?;
-                o.int(p, b" ")?;
-            }
-            None => o.size(0, b" ")?,
-        }
+        o.size(1, b" ")?;
+        o.int(etag, b" ")?;
         o.size(0, b"\n")?;
     }
     if ents.has_volume {
@@ -239,9 +247,9 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
             o.double(x, b" ")?;
         }
         o.size(1, b" ")?;
-        o.int(VOLUME_TAG, b" ")?;
-        o.size(ents.surfaces.len() as u64, b"")?;
-        for &(etag, _) in ents.surfaces.values() {
+        o.int(ents.groups.volume, b" ")?;
+        o.size(surfaces.len() as u64, b"")?;
+        for &etag in &surfaces {
             if !o.binary {
                 o.raw(b" ")?;
             }
@@ -330,6 +338,7 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
 fn write22<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
     let ents = Entities::new(view);
     o.header("2.2")?;
+    o.names(&ents.groups)?;
 
     let n = view.nodes.len();
     o.raw(b"$Nodes\n")?;
@@ -359,14 +368,13 @@ fn write22<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
         o.int(view.tri6.len() as i32, b"")?;
         o.int(2, b"")?;
     }
-    for ((t, &etag), &btag) in view.tri6.iter().zip(&ents.tri_entity).zip(view.tags) {
-        let phys = ents.surfaces[&btag].1;
+    for (t, &etag) in view.tri6.iter().zip(&ents.tri_entity) {
         o.int(id, b" ")?;
         id += 1;
         if !o.binary {
             o.raw(b"9 2 ")?;
         }
-        o.int(phys.unwrap_or(0), b" ")?;
+        o.int(etag, b" ")?;
         o.int(etag, b" ")?;
         let t = order::tri6_to(Convention::Gmsh, t);
         for (k, &v) in t.iter().enumerate() {
@@ -384,7 +392,7 @@ fn write22<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
         if !o.binary {
             o.raw(b"11 2 ")?;
         }
-        o.int(VOLUME_TAG, b" ")?;
+        o.int(ents.groups.volume, b" ")?;
         o.int(VOLUME_ENTITY, b" ")?;
         let t = order::tet10_to(Convention::Gmsh, t);
         for (k, &v) in t.iter().enumerate() {

@@ -31,7 +31,8 @@ pub fn surface_from_raw_any(raw: RawMesh, name: &str, opts: &CurveOptions) -> Re
                 format!("{name}: a linear volume mesh; give its boundary surface instead"),
             ));
         }
-        return curve_linear(raw.nodes, raw.tri3, raw.tri3_tags, opts);
+        let groups = raw.groups();
+        return Ok(curve_linear(raw.nodes, raw.tri3, raw.tri3_tags, opts)?.with_groups(groups));
     }
     surface_from_raw(raw, name)
 }
@@ -55,6 +56,7 @@ pub fn surface_from_raw(raw: RawMesh, name: &str) -> Result<Surface> {
         };
         return Err(Error::surface(kind, msg));
     }
+    let groups = raw.groups();
     let (nodes, tris) = if raw.tet4.is_empty() && raw.tet10.is_empty() {
         (raw.nodes, raw.tri6)
     } else {
@@ -74,5 +76,5 @@ pub fn surface_from_raw(raw: RawMesh, name: &str) -> Result<Surface> {
         }
         (nodes, tris)
     };
-    Surface::new(nodes, tris, raw.tri6_tags)
+    Ok(Surface::new(nodes, tris, raw.tri6_tags)?.with_groups(groups))
 }

@@ -1,21 +1,28 @@
-//! Legacy VTK `.vtk` files, ASCII `UNSTRUCTURED_GRID` only.
+//! Legacy VTK `.vtk` files, `UNSTRUCTURED_GRID`, ASCII or BINARY.
 //!
 //! Hand-written: the legacy format is a flat token stream (no crate worth a dependency
 //! covers it); we read both the classic `CELLS n size` layout and the 5.x
 //! `OFFSETS`/`CONNECTIVITY` layout, skip point data and unknown cell arrays, and take
-//! the tags from the first cell array named in `vtk_cells::TAG_ARRAYS`.
+//! the tags from the first cell array named in `vtk_cells::TAG_ARRAYS`. In a BINARY file
+//! the keyword lines are text and each data block is big-endian values of the type its
+//! line names, starting after that line's break.
 
 use std::io::{self, Write};
 
 use super::cursor::{capped, parse_f64, parse_i64, show, Cursor};
-use super::text_out::{int, point, uint};
-use super::vtk_cells::{self, add_cell, tag_rank, TAG_ARRAY};
+use super::text_out::{float, int, point, uint};
+use super::vtk_cells::{self, add_cell, tag_rank, QUALITY_ARRAYS, TAG_ARRAY};
 use super::{MeshView, RawMesh};
 use crate::error::Result;
 
 /// Write an ASCII legacy VTK file (version 4.2 layout): tetrahedra and boundary
-/// triangles, and the Int32 cell array `BoundaryTag`.
-pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView) -> io::Result<()> {
+/// triangles, the Int32 cell array `BoundaryTag`, and with `quality` (per tetrahedron)
+/// the double cell arrays of [`QUALITY_ARRAYS`] (0 for triangles).
+pub(crate) fn write<W: Write>(
+    w: &mut W,
+    view: &MeshView,
+    quality: Option<&[[f64; 2]]>,
+) -> io::Result<()> {
     w.write_all(
         b"# vtk DataFile Version 4.2\ncurvetet P2 mesh\nASCII\nDATASET UNSTRUCTURED_GRID\n",
     )?;
@@ -56,6 +63,20 @@ pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView) -> io::Result<()> {
         int(w, c.tag as i64)?;
         w.write_all(b"\n")?;
     }
+    for (k, name) in QUALITY_ARRAYS.iter().enumerate() {
+        let Some(q) = quality else { break };
+        w.write_all(b"SCALARS ")?;
+        w.write_all(name.as_bytes())?;
+        w.write_all(b" double 1\nLOOKUP_TABLE default\n")?;
+        for v in q
+            .iter()
+            .map(|e| e[k])
+            .chain((0..view.tri6.len()).map(|_| 0.0))
+        {
+            float(w, v)?;
+            w.write_all(b"\n")?;
+        }
+    }
     Ok(())
 }
 
@@ -78,9 +99,53 @@ struct Legacy<'a> {
     tags: Option<(usize, Vec<i32>)>,
     attach: Attach,
     attach_count: u64,
+    /// A BINARY file: data blocks are big-endian values.
+    binary: bool,
 }
 
-/// Read a legacy ASCII .vtk file held in `data`.
+/// A legacy data type: its size in bytes and whether it is a float.
+#[derive(Clone, Copy)]
+struct Scalar {
+    size: usize,
+    float: bool,
+    signed: bool,
+}
+
+impl Scalar {
+    const I32: Scalar = Scalar {
+        size: 4,
+        float: false,
+        signed: true,
+    };
+    const U8: Scalar = Scalar {
+        size: 1,
+        float: false,
+        signed: false,
+    };
+
+    fn parse(t: &[u8]) -> Option<Scalar> {
+        let (size, float, signed) = match t.to_ascii_lowercase().as_slice() {
+            b"char" | b"vtktypeint8" => (1, false, true),
+            b"unsigned_char" | b"vtktypeuint8" => (1, false, false),
+            b"short" | b"vtktypeint16" => (2, false, true),
+            b"unsigned_short" | b"vtktypeuint16" => (2, false, false),
+            b"int" | b"vtktypeint32" => (4, false, true),
+            b"unsigned_int" | b"vtktypeuint32" => (4, false, false),
+            b"long" | b"vtktypeint64" | b"vtkidtype" => (8, false, true),
+            b"unsigned_long" | b"vtktypeuint64" => (8, false, false),
+            b"float" => (4, true, true),
+            b"double" => (8, true, true),
+            _ => return None,
+        };
+        Some(Scalar {
+            size,
+            float,
+            signed,
+        })
+    }
+}
+
+/// Read a legacy (ASCII or BINARY) .vtk file held in `data`.
 pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
     let mut c = Cursor::new(data, name);
     let first = c.rest_of_line();
@@ -89,10 +154,8 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
     }
     c.rest_of_line(); // title
     let enc = c.expect_token("ASCII or BINARY")?;
-    if enc.eq_ignore_ascii_case(b"BINARY") {
-        return Err(c.err("binary legacy VTK files are not supported (use ASCII or .vtu)"));
-    }
-    if !enc.eq_ignore_ascii_case(b"ASCII") {
+    let binary = enc.eq_ignore_ascii_case(b"BINARY");
+    if !binary && !enc.eq_ignore_ascii_case(b"ASCII") {
         return Err(c.err(format!("expected ASCII or BINARY, found '{}'", show(enc))));
     }
     let mut r = Legacy {
@@ -105,7 +168,9 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
         tags: None,
         attach: Attach::None,
         attach_count: 0,
+        binary,
     };
+    r.c.set_swap(binary);
     r.body()?;
     r.finish()
 }
@@ -117,6 +182,90 @@ fn upper(t: &[u8]) -> Vec<u8> {
 impl<'a> Legacy<'a> {
     fn max(&self) -> u64 {
         self.c.remaining() as u64
+    }
+
+    /// The data type named by token `t`: in a binary file it must be one we know.
+    fn data_type(&self, t: &[u8]) -> Result<Option<Scalar>> {
+        match Scalar::parse(t) {
+            None if self.binary => Err(self.c.err(format!(
+                "data type '{}' is not supported in a binary file",
+                show(t)
+            ))),
+            s => Ok(s),
+        }
+    }
+
+    /// Before a data block: in a binary file, move past the keyword line's break.
+    fn start_data(&mut self) {
+        if self.binary {
+            self.c.rest_of_line();
+        }
+    }
+
+    /// Does the current line hold another token? (In a binary file, data follows the
+    /// line: a token must not be looked for past its break.)
+    fn line_has_more(&self) -> bool {
+        let d = self.c.data();
+        let mut p = self.c.pos();
+        while p < d.len() && d[p] != b'\n' {
+            if !d[p].is_ascii_whitespace() {
+                return true;
+            }
+            p += 1;
+        }
+        false
+    }
+
+    /// One value of a data block: a token in ASCII, `ty`'s big-endian bytes in binary;
+    /// integers as `Ok(Err(i))`, floats as `Ok(Ok(x))`.
+    fn value(&mut self, ty: Option<Scalar>, what: &str) -> Result<std::result::Result<f64, i64>> {
+        if !self.binary {
+            let t = self.c.expect_token(what)?;
+            if let Some(i) = parse_i64(t) {
+                return Ok(Err(i));
+            }
+            return parse_f64(t).map(Ok).ok_or_else(|| {
+                self.c
+                    .err(format!("invalid number '{}' for {what}", show(t)))
+            });
+        }
+        let ty = ty.expect("binary data blocks have a known type");
+        let b = self.c.bytes(ty.size, what)?;
+        let mut w = [0u8; 8];
+        for (k, &x) in b.iter().rev().enumerate() {
+            w[k] = x;
+        }
+        Ok(match (ty.float, ty.size) {
+            (true, 4) => Ok(f32::from_le_bytes(w[..4].try_into().expect("4")) as f64),
+            (true, _) => Ok(f64::from_le_bytes(w)),
+            (false, n) => {
+                let v = u64::from_le_bytes(w);
+                let bits = 8 * n as u32;
+                if ty.signed && n < 8 && v >> (bits - 1) & 1 == 1 {
+                    Err((v | (u64::MAX << bits)) as i64)
+                } else {
+                    Err(v as i64)
+                }
+            }
+        })
+    }
+
+    fn float(&mut self, ty: Option<Scalar>, what: &str) -> Result<f64> {
+        Ok(match self.value(ty, what)? {
+            Ok(x) => x,
+            Err(i) => i as f64,
+        })
+    }
+
+    /// A non-negative integer value.
+    fn uint(&mut self, ty: Option<Scalar>, what: &str) -> Result<u64> {
+        match self.value(ty, what)? {
+            Err(i) if i >= 0 => Ok(i as u64),
+            Err(i) => Err(self
+                .c
+                .err(format!("invalid non-negative integer {i} for {what}"))),
+            Ok(x) => Err(self.c.err(format!("{what} {x} is not an integer"))),
+        }
     }
 
     fn body(&mut self) -> Result<()> {
@@ -159,7 +308,8 @@ impl<'a> Legacy<'a> {
                 b"LOOKUP_TABLE" => {
                     self.c.expect_token("table name")?;
                     let n = self.c.count("table size", self.max())?;
-                    self.skip_values(n.saturating_mul(4))?;
+                    self.start_data();
+                    self.skip_values(Some(Scalar::U8), n.saturating_mul(4))?;
                 }
                 b"METADATA" => self.metadata(),
                 _ => return Err(self.c.err(format!("unexpected keyword '{}'", show(tok)))),
@@ -173,20 +323,22 @@ impl<'a> Legacy<'a> {
             return Err(self.c.err("a second POINTS section"));
         }
         let n = self.c.count("number of points", u32::MAX as u64 - 1)?;
-        self.c.expect_token("point data type")?;
+        let t = self.c.expect_token("point data type")?;
+        let ty = self.data_type(t)?;
+        self.start_data();
         let mut p = Vec::with_capacity(capped(n, self.c.remaining(), 6));
         for _ in 0..n {
-            let x = self.c.f64("x coordinate")?;
-            let y = self.c.f64("y coordinate")?;
-            let z = self.c.f64("z coordinate")?;
+            let x = self.float(ty, "x coordinate")?;
+            let y = self.float(ty, "y coordinate")?;
+            let z = self.float(ty, "z coordinate")?;
             p.push([x, y, z]);
         }
         self.points = Some(p);
         Ok(())
     }
 
-    fn index(&mut self, npoints: u64, cell: usize) -> Result<u64> {
-        let v = self.c.u64("point index")?;
+    fn index(&mut self, ty: Option<Scalar>, npoints: u64, cell: usize) -> Result<u64> {
+        let v = self.uint(ty, "point index")?;
         if v >= npoints {
             return Err(self.c.err(format!(
                 "cell {cell} refers to point {v}, but there are {npoints} points"
@@ -208,10 +360,12 @@ impl<'a> Legacy<'a> {
         if self.c.peek_token() == Some(b"OFFSETS") {
             // VTK 5.x: a = number of offsets (cells + 1), b = connectivity length.
             self.c.token();
-            self.c.expect_token("offsets type")?;
+            let t = self.c.expect_token("offsets type")?;
+            let ty = self.data_type(t)?;
+            self.start_data();
             self.offsets.reserve(capped(a, self.c.remaining(), 2));
             for _ in 0..a {
-                let o = self.c.u64("offset")?;
+                let o = self.uint(ty, "offset")?;
                 if o > b || self.offsets.last().is_some_and(|&l| o < l) {
                     return Err(self.c.err(format!("bad cell offset {o}")));
                 }
@@ -221,14 +375,16 @@ impl<'a> Legacy<'a> {
                 return Err(self.c.err("the first cell offset must be 0"));
             }
             self.c.expect_word("CONNECTIVITY")?;
-            self.c.expect_token("connectivity type")?;
+            let t = self.c.expect_token("connectivity type")?;
+            let ty = self.data_type(t)?;
+            self.start_data();
             self.conn.reserve(capped(b, self.c.remaining(), 2));
             let mut cell = 0;
             for k in 0..b {
                 while cell + 1 < self.offsets.len() && self.offsets[cell + 1] <= k {
                     cell += 1;
                 }
-                let v = self.index(npoints, cell)?;
+                let v = self.index(ty, npoints, cell)?;
                 self.conn.push(v);
             }
             if self.offsets.is_empty() {
@@ -243,10 +399,17 @@ impl<'a> Legacy<'a> {
             self.offsets.reserve(capped(a, self.c.remaining(), 2) + 1);
             self.conn.reserve(capped(b, self.c.remaining(), 2));
             self.offsets.push(0);
+            self.start_data();
+            let ty = Some(Scalar::I32);
             for cell in 0..a as usize {
-                let k = self.c.count("number of cell points", self.max())?;
+                let k = self.uint(ty, "number of cell points")?;
+                if k > self.max() {
+                    return Err(self.c.err(format!(
+                        "cell {cell} has {k} points, more than the file holds"
+                    )));
+                }
                 for _ in 0..k {
-                    let v = self.index(npoints, cell)?;
+                    let v = self.index(ty, npoints, cell)?;
                     self.conn.push(v);
                 }
                 self.offsets.push(self.conn.len() as u64);
@@ -276,8 +439,12 @@ impl<'a> Legacy<'a> {
                 .err(format!("CELL_TYPES has {n} cells but CELLS has {ncells}")));
         }
         let mut t = Vec::with_capacity(capped(n, self.c.remaining(), 2));
+        self.start_data();
         for i in 0..n as usize {
-            let ty = self.c.i64("cell type")?;
+            let ty = match self.value(Some(Scalar::I32), "cell type")? {
+                Err(i) => i,
+                Ok(x) => return Err(self.c.err(format!("cell type {x} is not an integer"))),
+            };
             let len = self.offsets[i + 1] - self.offsets[i];
             if let Some(want) = vtk_cells::cell_len(ty) {
                 if len != want as u64 {
@@ -295,9 +462,14 @@ impl<'a> Legacy<'a> {
     /// `SCALARS name type [ncomp]`, an optional `LOOKUP_TABLE name`, then the values.
     fn scalars(&mut self) -> Result<()> {
         let name = self.c.expect_token("array name")?;
-        self.c.expect_token("data type")?;
+        let t = self.c.expect_token("data type")?;
+        let ty = self.data_type(t)?;
         let mut ncomp = 1;
-        if let Some(t) = self.c.peek_token() {
+        if let Some(t) = self
+            .c
+            .peek_token()
+            .filter(|_| !self.binary || self.line_has_more())
+        {
             if let Some(v) = parse_i64(t) {
                 self.c.token();
                 if !(1..=4).contains(&v) {
@@ -315,7 +487,8 @@ impl<'a> Legacy<'a> {
             self.c.expect_token("lookup table name")?;
         }
         let n = self.attached()?.saturating_mul(ncomp);
-        self.values(name, n, ncomp == 1)
+        self.start_data();
+        self.values(name, ty, n, ncomp == 1)
     }
 
     /// `FIELD name narrays`, then per array `name ncomp ntuples type` and the values.
@@ -326,9 +499,11 @@ impl<'a> Legacy<'a> {
             let name = self.c.expect_token("array name")?;
             let ncomp = self.c.count("number of components", self.max())?;
             let ntuples = self.c.count("number of tuples", self.max())?;
-            self.c.expect_token("data type")?;
+            let t = self.c.expect_token("data type")?;
+            let ty = self.data_type(t)?;
+            self.start_data();
             let is_tag = ncomp == 1 && self.attach == Attach::Cells && ntuples == self.attach_count;
-            self.values(name, ncomp.saturating_mul(ntuples), is_tag)?;
+            self.values(name, ty, ncomp.saturating_mul(ntuples), is_tag)?;
             if self.c.peek_token().is_some_and(|t| t == b"METADATA") {
                 self.c.token();
                 self.metadata();
@@ -346,7 +521,7 @@ impl<'a> Legacy<'a> {
     }
 
     /// Read `n` values; keep them as tags if `maybe_tag` and the array has a tag name.
-    fn values(&mut self, name: &[u8], n: u64, maybe_tag: bool) -> Result<()> {
+    fn values(&mut self, name: &[u8], ty: Option<Scalar>, n: u64, maybe_tag: bool) -> Result<()> {
         let rank = if maybe_tag && self.attach == Attach::Cells {
             tag_rank(name)
         } else {
@@ -358,35 +533,52 @@ impl<'a> Legacy<'a> {
             (Some((old, _)), Some(r)) => r < *old,
         };
         if !better {
-            return self.skip_values(n);
+            return self.skip_values(ty, n);
         }
         let mut tags = Vec::with_capacity(capped(n, self.c.remaining(), 2));
         for _ in 0..n {
-            let t = self.c.expect_token("tag value")?;
-            let v = parse_i64(t)
-                .or_else(|| parse_f64(t).filter(|v| v.fract() == 0.0).map(|v| v as i64))
+            let v = match self.value(ty, "tag value")? {
+                Err(i) => Some(i),
+                Ok(x) => (x.fract() == 0.0 && x.abs() < 1e18).then_some(x as i64),
+            };
+            let v = v
                 .and_then(|v| i32::try_from(v).ok())
-                .ok_or_else(|| self.c.err(format!("invalid tag value '{}'", show(t))))?;
+                .ok_or_else(|| self.c.err("invalid tag value (not a 32-bit integer)"))?;
             tags.push(v);
         }
         self.tags = Some((rank.expect("ranked"), tags));
         Ok(())
     }
 
-    fn skip_values(&mut self, n: u64) -> Result<()> {
+    fn skip_values(&mut self, ty: Option<Scalar>, n: u64) -> Result<()> {
+        if self.binary {
+            let size = ty.expect("binary data blocks have a known type").size as u64;
+            let bytes = n
+                .checked_mul(size)
+                .filter(|&b| b <= self.max())
+                .ok_or_else(|| self.c.eof(&format!("{n} data values")))?;
+            self.c.bytes(bytes as usize, "data values")?;
+            return Ok(());
+        }
         for _ in 0..n {
             self.c.expect_token("a data value")?;
         }
         Ok(())
     }
 
+    /// Skip an attribute of `ncomp` values per tuple: `typed` ones name their data type
+    /// (after the array name), the others are unsigned chars in binary.
     fn skip_attribute(&mut self, ncomp: usize, typed: bool) -> Result<()> {
-        if typed {
+        let ty = if typed {
             self.c.expect_token("array name")?;
-            self.c.expect_token("data type")?;
-        }
+            let t = self.c.expect_token("data type")?;
+            self.data_type(t)?
+        } else {
+            Some(Scalar::U8)
+        };
         let n = self.attached()?.saturating_mul(ncomp as u64);
-        self.skip_values(n)
+        self.start_data();
+        self.skip_values(ty, n)
     }
 
     /// VTK 5 `METADATA` blocks run to the next blank line.

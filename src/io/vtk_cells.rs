@@ -16,6 +16,9 @@ pub(crate) const QUADRATIC_TETRA: u8 = 24;
 /// The cell array curvetet writes the tags to.
 pub(crate) const TAG_ARRAY: &str = "BoundaryTag";
 
+/// The per-tetrahedron quality cell arrays (as the VTK filter names them).
+pub(crate) const QUALITY_ARRAYS: [&str; 2] = ["ScaledJacobian", "EquiangularSkewness"];
+
 /// Cell arrays read as tags, most preferred first (ours, then meshio's and Gmsh's
 /// names, then common solver names).
 pub(crate) const TAG_ARRAYS: [&str; 7] = [

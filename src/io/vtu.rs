@@ -1,21 +1,22 @@
 //! Reading VTK XML unstructured grid `.vtu` files.
 //!
-//! The XML is parsed by `quick-xml` (zero-copy over the in-memory file) and base64 by
-//! `base64`; the data arrays' numbers are parsed by our own cursor. Read: `ascii` arrays
-//! and inline `binary` (base64) arrays with a UInt32 or UInt64 header, either byte
-//! order, uncompressed, header encoded apart (as VTK does for compressed data) or in one
-//! stream with the data (as VTK and meshio do otherwise); compressed and `appended`
-//! arrays give a clear parse error. Several pieces are concatenated.
+//! The XML is parsed by `quick-xml` (zero-copy over the in-memory file); the data arrays'
+//! text numbers are parsed by our own cursor, binary ones through [`vtu_data`]. Read:
+//! `ascii` arrays, inline `binary` (base64) arrays, and `appended` arrays in an
+//! `<AppendedData>` section of `raw` or `base64` encoding (VTK's writer default); a
+//! UInt32 or UInt64 header, either byte order, uncompressed or zlib- or LZ4-compressed
+//! (meshio's and VTK's defaults). Several pieces are concatenated.
+//!
+//! [`vtu_data`]: super::vtu_data
 
-use base64::engine::general_purpose::STANDARD;
-use base64::Engine;
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
 use std::borrow::Cow;
 
 use super::cursor::{capped, parse_f64, parse_i64, show, Cursor};
 use super::vtk_cells::{self, add_cell, tag_rank};
-use super::RawMesh;
+use super::vtu_data::{array_bytes, base64_runs, Compressor, Layout};
+use super::{PhysicalName, RawMesh};
 use crate::error::{Error, Result};
 
 /// The deepest nesting of XML elements read. A VTU file nests about six deep (VTKFile,
@@ -90,6 +91,9 @@ enum Target {
     Offsets,
     Types,
     Tag(usize),
+    /// A field data array (tag, dimension) naming a physical group, as meshio writes
+    /// Gmsh's physical names.
+    Group,
     Skip,
 }
 
@@ -104,6 +108,18 @@ struct Array<'a> {
     /// The content is a single slice of the file starting at `content_at`.
     in_file: bool,
     content: Cow<'a, [u8]>,
+    /// For an `appended` array: its offset into the appended data.
+    appended: Option<u64>,
+    /// Its `Name` (kept for [`Target::Group`] arrays only).
+    name: String,
+}
+
+/// An appended array of a piece, read when the `<AppendedData>` section is reached.
+struct Pending {
+    target: Target,
+    ty: NumType,
+    offset: u64,
+    at: usize,
 }
 
 #[derive(Default)]
@@ -116,6 +132,7 @@ struct Piece {
     offsets: Option<Values>,
     types: Option<Values>,
     tags: Option<(usize, Values)>,
+    pending: Vec<Pending>,
 }
 
 struct Vtu<'a> {
@@ -123,8 +140,11 @@ struct Vtu<'a> {
     name: &'a str,
     header64: bool,
     big_endian: bool,
-    compressed: bool,
+    compressor: Compressor,
     seen_file: bool,
+    /// Pieces waiting for their appended arrays (and the pieces after them, kept in
+    /// order), with the offsets of their `</Piece>`.
+    deferred: Vec<(Piece, usize)>,
     mesh: RawMesh,
     piece: Option<Piece>,
     array: Option<Array<'a>>,
@@ -137,8 +157,9 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
         name,
         header64: false,
         big_endian: false,
-        compressed: false,
+        compressor: Compressor::None,
         seen_file: false,
+        deferred: Vec::new(),
         mesh: RawMesh::default(),
         piece: None,
         array: None,
@@ -179,7 +200,8 @@ impl<'a> Vtu<'a> {
                 Event::Start(e) => {
                     let name = e.local_name().as_ref().to_vec();
                     if name == b"AppendedData" {
-                        // Everything we read precedes it; its raw bytes are not XML.
+                        // Everything else precedes it; its raw bytes are not XML.
+                        self.appended(&e, before, rd.buffer_position() as usize)?;
                         break;
                     }
                     if path.len() >= MAX_DEPTH {
@@ -230,7 +252,73 @@ impl<'a> Vtu<'a> {
         if !self.seen_file {
             return Err(self.err(0, "not a VTK XML file: no <VTKFile> element"));
         }
+        if let Some(p) = self.deferred.first().and_then(|(p, _)| p.pending.first()) {
+            return Err(self.err(
+                p.at,
+                "an appended data array, but the file has no <AppendedData> section",
+            ));
+        }
         Ok(())
+    }
+
+    /// Read the deferred pieces' appended arrays from the `<AppendedData>` element
+    /// starting at `at`, whose start tag ends at `content`.
+    fn appended(&mut self, e: &BytesStart, at: usize, content: usize) -> Result<()> {
+        let encoding = attr(e, b"encoding").unwrap_or(Cow::Borrowed(b"raw"));
+        let base64 = match encoding.trim_ascii() {
+            b"raw" => false,
+            b"base64" => true,
+            other => {
+                return Err(self.err(
+                    at,
+                    format!("unknown appended data encoding '{}'", show(other)),
+                ))
+            }
+        };
+        // The data starts after an underscore.
+        let rest = &self.data[content.min(self.data.len())..];
+        let skip = rest.iter().take_while(|b| b.is_ascii_whitespace()).count();
+        if rest.get(skip) != Some(&b'_') {
+            return Err(self.err(content + skip, "<AppendedData> does not start with '_'"));
+        }
+        let start = content + skip + 1;
+        let layout = self.layout();
+        for (mut piece, end) in std::mem::take(&mut self.deferred) {
+            for p in std::mem::take(&mut piece.pending) {
+                let from = usize::try_from(p.offset)
+                    .ok()
+                    .and_then(|o| o.checked_add(start))
+                    .filter(|&o| o <= self.data.len())
+                    .ok_or_else(|| {
+                        self.err(
+                            p.at,
+                            format!(
+                                "appended data offset {} is past the end of the file",
+                                p.offset
+                            ),
+                        )
+                    })?;
+                let bytes: Cow<[u8]> = if base64 {
+                    Cow::Owned(base64_runs(&self.data[from..]).map_err(|m| self.err(p.at, m))?)
+                } else {
+                    Cow::Borrowed(&self.data[from..])
+                };
+                let values = array_bytes(&bytes, layout)
+                    .map_err(|m| self.err(p.at, m))
+                    .and_then(|b| self.values(&b, p.ty, p.at))?;
+                store(&mut piece, p.target, p.at, values);
+            }
+            self.finish_piece(piece, end)?;
+        }
+        Ok(())
+    }
+
+    fn layout(&self) -> Layout {
+        Layout {
+            header64: self.header64,
+            big_endian: self.big_endian,
+            compressor: self.compressor,
+        }
     }
 
     fn open(&mut self, e: &BytesStart, path: &[Vec<u8>], at: usize) -> Result<()> {
@@ -252,8 +340,8 @@ impl<'a> Vtu<'a> {
                 self.header64 = attr(e, b"header_type").as_deref() == Some(b"UInt64".as_slice());
                 self.big_endian =
                     attr(e, b"byte_order").as_deref() == Some(b"BigEndian".as_slice());
-                self.compressed =
-                    attr(e, b"compressor").is_some_and(|c| !c.trim_ascii().is_empty());
+                self.compressor = Compressor::parse(attr(e, b"compressor").as_deref())
+                    .map_err(|m| self.err(at, m))?;
             }
             b"Piece" => {
                 if parent != Some(b"UnstructuredGrid".as_slice()) {
@@ -278,14 +366,31 @@ impl<'a> Vtu<'a> {
 
     fn open_array(&mut self, e: &BytesStart, parent: Option<&[u8]>, at: usize) -> Result<()> {
         let Some(piece) = &self.piece else {
+            // Outside a piece: only a group's name, (tag, dim) of an integer type in ascii
+            // or inline binary, is read; anything else there is skipped.
+            let ty = attr(e, b"type").and_then(|t| NumType::parse(&t));
+            let format = attr(e, b"format");
+            let group = parent == Some(b"FieldData".as_slice())
+                && attr_u64(e, b"NumberOfComponents") == Some(2)
+                && attr_u64(e, b"NumberOfTuples").unwrap_or(1) == 1
+                && ty.is_some_and(|t| !t.is_float())
+                && matches!(format.as_deref(), Some(b"ascii") | Some(b"binary") | None);
             self.array = Some(Array {
-                target: Target::Skip,
-                ty: NumType::U8,
-                binary: false,
+                target: if group { Target::Group } else { Target::Skip },
+                ty: ty.unwrap_or(NumType::U8),
+                binary: format.as_deref() == Some(b"binary".as_slice()),
                 at,
                 content_at: None,
                 in_file: false,
                 content: Cow::Borrowed(b""),
+                appended: None,
+                name: attr(e, b"Name")
+                    .and_then(|n| {
+                        quick_xml::escape::unescape(&String::from_utf8_lossy(&n))
+                            .ok()
+                            .map(|c| c.into_owned())
+                    })
+                    .unwrap_or_default(),
             });
             return Ok(());
         };
@@ -311,6 +416,7 @@ impl<'a> Vtu<'a> {
         let tyname = attr(e, b"type").unwrap_or(Cow::Borrowed(b""));
         let ty = NumType::parse(&tyname);
         let format = attr(e, b"format").unwrap_or(Cow::Borrowed(b"ascii"));
+        let mut appended = None;
         if target != Target::Skip {
             if ty.is_none() {
                 return Err(self.err(at, format!("unknown data type '{}'", show(&tyname))));
@@ -318,18 +424,11 @@ impl<'a> Vtu<'a> {
             match format.as_ref() {
                 b"ascii" | b"binary" => {}
                 b"appended" => {
-                    return Err(self.err(
-                        at,
-                        "appended data arrays are not supported (save the file with ASCII or inline binary data)",
-                    ))
+                    appended = Some(attr_u64(e, b"offset").ok_or_else(|| {
+                        self.err(at, "an appended data array without a valid offset")
+                    })?)
                 }
                 f => return Err(self.err(at, format!("unknown data format '{}'", show(f)))),
-            }
-            if format.as_ref() == b"binary" && self.compressed {
-                return Err(self.err(
-                    at,
-                    "compressed binary data arrays are not supported (save the file uncompressed)",
-                ));
             }
         } else {
             target = Target::Skip;
@@ -342,6 +441,8 @@ impl<'a> Vtu<'a> {
             content_at: None,
             in_file: false,
             content: Cow::Borrowed(b""),
+            appended,
+            name: String::new(),
         });
         Ok(())
     }
@@ -374,14 +475,20 @@ impl<'a> Vtu<'a> {
         match name {
             b"DataArray" => {
                 if let Some(a) = self.array.take() {
-                    if a.target != Target::Skip {
+                    if a.target == Target::Group {
+                        self.group_name(a)?;
+                    } else if a.target != Target::Skip {
                         self.finish_array(a)?;
                     }
                 }
             }
             b"Piece" => {
                 if let Some(p) = self.piece.take() {
-                    self.finish_piece(p, at)?;
+                    if p.pending.is_empty() && self.deferred.is_empty() {
+                        self.finish_piece(p, at)?;
+                    } else {
+                        self.deferred.push((p, at));
+                    }
                 }
             }
             _ => {}
@@ -389,22 +496,53 @@ impl<'a> Vtu<'a> {
         Ok(())
     }
 
-    fn finish_array(&mut self, a: Array<'a>) -> Result<()> {
+    /// A field data array naming a group: kept when it holds (tag, dimension 0..3).
+    fn group_name(&mut self, a: Array<'a>) -> Result<()> {
         let at = a.content_at.unwrap_or(a.at);
         let values = if a.binary {
-            self.decode_binary(&a.content, a.ty, at)?
+            let bytes = base64_runs(a.content.trim_ascii())
+                .and_then(|b| array_bytes(&b, self.layout()))
+                .map_err(|m| self.err(at, m))?;
+            self.values(&bytes, a.ty, at)?
+        } else {
+            self.decode_ascii(&a, at)?
+        };
+        if let Values::I(v) = values {
+            if let [tag, dim] = v[..] {
+                if let (Ok(tag), true) = (i32::try_from(tag), (0..=3).contains(&dim)) {
+                    self.mesh.physical_names.push(PhysicalName {
+                        dim: dim as u8,
+                        tag,
+                        name: a.name,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn finish_array(&mut self, a: Array<'a>) -> Result<()> {
+        if let Some(offset) = a.appended {
+            let piece = self.piece.as_mut().expect("arrays are read inside a piece");
+            piece.pending.push(Pending {
+                target: a.target,
+                ty: a.ty,
+                offset,
+                at: a.at,
+            });
+            return Ok(());
+        }
+        let at = a.content_at.unwrap_or(a.at);
+        let values = if a.binary {
+            let bytes = base64_runs(a.content.trim_ascii())
+                .and_then(|b| array_bytes(&b, self.layout()))
+                .map_err(|m| self.err(at, m))?;
+            self.values(&bytes, a.ty, at)?
         } else {
             self.decode_ascii(&a, at)?
         };
         let piece = self.piece.as_mut().expect("arrays are read inside a piece");
-        match a.target {
-            Target::Points => piece.points = Some(values),
-            Target::Connectivity => piece.conn = Some((at, values)),
-            Target::Offsets => piece.offsets = Some(values),
-            Target::Types => piece.types = Some(values),
-            Target::Tag(r) => piece.tags = Some((r, values)),
-            Target::Skip => {}
-        }
+        store(piece, a.target, at, values);
         Ok(())
     }
 
@@ -447,58 +585,8 @@ impl<'a> Vtu<'a> {
         }
     }
 
-    fn decode_binary(&self, content: &[u8], ty: NumType, at: usize) -> Result<Values> {
-        let trimmed = content.trim_ascii();
-        let b64: Cow<[u8]> = if trimmed.iter().any(|b| b.is_ascii_whitespace()) {
-            Cow::Owned(
-                trimmed
-                    .iter()
-                    .copied()
-                    .filter(|b| !b.is_ascii_whitespace())
-                    .collect(),
-            )
-        } else {
-            Cow::Borrowed(trimmed)
-        };
-        let hsize: usize = if self.header64 { 8 } else { 4 };
-        let hchars = hsize.div_ceil(3) * 4;
-        if b64.len() < hchars {
-            return Err(self.err(at, "binary data array shorter than its header"));
-        }
-        let bad = |e: base64::DecodeError| self.err(at, format!("invalid base64 data: {e}"));
-        // VTK may encode the header separately (then it ends in exactly `pad` '='s: two
-        // for a 4-byte header, one for 8 bytes) or in one stream with the data.
-        let pad = (3 - hsize % 3) % 3;
-        let separate =
-            b64[hchars - pad..hchars].iter().all(|&b| b == b'=') && b64[hchars - pad - 1] != b'=';
-        let (header, payload) = if separate {
-            let h = STANDARD.decode(&b64[..hchars]).map_err(bad)?;
-            let p = STANDARD.decode(&b64[hchars..]).map_err(bad)?;
-            (h, p)
-        } else {
-            let mut all = STANDARD.decode(&b64).map_err(bad)?;
-            let p = all.split_off(hsize.min(all.len()));
-            (all, p)
-        };
-        if header.len() < hsize {
-            return Err(self.err(at, "binary data array shorter than its header"));
-        }
-        let mut h = [0u8; 8];
-        h[..hsize].copy_from_slice(&header[..hsize]);
-        if self.big_endian {
-            h[..hsize].reverse();
-        }
-        let nbytes = u64::from_le_bytes(h);
-        if nbytes > payload.len() as u64 {
-            return Err(self.err(
-                at,
-                format!(
-                    "binary data array declares {nbytes} bytes but holds {}",
-                    payload.len()
-                ),
-            ));
-        }
-        let payload = &payload[..nbytes as usize];
+    /// The values of an array's data bytes (file byte order).
+    fn values(&self, payload: &[u8], ty: NumType, at: usize) -> Result<Values> {
         let size = ty.size();
         if payload.len() % size != 0 {
             return Err(self.err(
@@ -565,6 +653,7 @@ impl<'a> Vtu<'a> {
             offsets,
             types,
             tags,
+            pending: _,
         } = p;
         let base = self.mesh.nodes.len() as u64;
         if base.saturating_add(npoints) >= u32::MAX as u64 {
@@ -675,5 +764,17 @@ impl<'a> Vtu<'a> {
             .map_err(|m| self.err(conn_at, m))?;
         }
         Ok(())
+    }
+}
+
+/// Put an array's values where they belong in the piece.
+fn store(piece: &mut Piece, target: Target, at: usize, values: Values) {
+    match target {
+        Target::Points => piece.points = Some(values),
+        Target::Connectivity => piece.conn = Some((at, values)),
+        Target::Offsets => piece.offsets = Some(values),
+        Target::Types => piece.types = Some(values),
+        Target::Tag(r) => piece.tags = Some((r, values)),
+        Target::Group | Target::Skip => {}
     }
 }

@@ -7,15 +7,37 @@ use std::io::{self, Write};
 use base64::engine::general_purpose::STANDARD;
 
 use super::text_out::{float, int, uint};
-use super::vtk_cells::{self, TAG_ARRAY};
-use super::MeshView;
+use super::vtk_cells::{self, QUALITY_ARRAYS, TAG_ARRAY};
+use super::{MeshView, PhysicalName};
 
-/// Write a `.vtu` file with the tetrahedra and the boundary triangles, and the Int32
-/// cell array `BoundaryTag` (0 for tetrahedra).
-pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView, binary: bool) -> io::Result<()> {
+/// Write a `.vtu` file with the tetrahedra and the boundary triangles, the Int32 cell
+/// array `BoundaryTag` (0 for tetrahedra), and with `quality` (per tetrahedron) the
+/// Float64 cell arrays of [`QUALITY_ARRAYS`] (0 for triangles). Each named group is a
+/// field data array of that name holding (tag, dimension), as meshio keeps Gmsh's
+/// physical names.
+pub(crate) fn write<W: Write>(
+    w: &mut W,
+    view: &MeshView,
+    names: &[PhysicalName],
+    quality: Option<&[[f64; 2]]>,
+    binary: bool,
+) -> io::Result<()> {
     let (ncells, nconn) = vtk_cells::sizes(view);
     let format = if binary { "binary" } else { "ascii" };
     w.write_all(b"<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n  <UnstructuredGrid>\n")?;
+    if !names.is_empty() {
+        w.write_all(b"    <FieldData>\n")?;
+        for n in names {
+            writeln!(
+                w,
+                "      <DataArray type=\"Int32\" Name=\"{}\" NumberOfTuples=\"1\" NumberOfComponents=\"2\" format=\"ascii\">{} {}</DataArray>",
+                quick_xml::escape::escape(n.name.as_str()),
+                n.tag,
+                n.dim
+            )?;
+        }
+        w.write_all(b"    </FieldData>\n")?;
+    }
     write!(
         w,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{ncells}\">\n      <Points>\n",
@@ -113,7 +135,31 @@ pub(crate) fn write<W: Write>(w: &mut W, view: &MeshView, binary: bool) -> io::R
         }
         Ok(())
     })?;
-    w.write_all(b"        </DataArray>\n      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
+    w.write_all(b"        </DataArray>\n")?;
+    for (k, name) in QUALITY_ARRAYS.iter().enumerate() {
+        let Some(q) = quality else { break };
+        writeln!(
+            w,
+            "        <DataArray type=\"Float64\" Name=\"{name}\" format=\"{format}\">"
+        )?;
+        array(w, binary, 8 * ncells, |w, bin| {
+            let values = q
+                .iter()
+                .map(|e| e[k])
+                .chain((0..view.tri6.len()).map(|_| 0.0));
+            for v in values {
+                if bin {
+                    w.write_all(&v.to_le_bytes())?;
+                } else {
+                    float(w, v)?;
+                    w.write_all(b"\n")?;
+                }
+            }
+            Ok(())
+        })?;
+        w.write_all(b"        </DataArray>\n")?;
+    }
+    w.write_all(b"      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n")
 }
 
 /// Write one data array's content: text as is, or base64 of (UInt64 byte count, data)

@@ -96,5 +96,6 @@ pub fn assemble(
         tets: out,
         boundary: surf_tris.to_vec(),
         boundary_tags: tags,
+        groups: Default::default(),
     }
 }

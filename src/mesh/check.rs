@@ -3,6 +3,11 @@
 //! orientations, boundary faces exactly the given boundary triangles (same orientation),
 //! one mid node per edge, and the linear volume equal to the volume the linear boundary
 //! encloses.
+//!
+//! A mesh of several regions (tets with region ids, as Gmsh physical volumes) may also
+//! list the interface triangles between two regions among its boundary triangles
+//! ([`check_conformity_regions`]): such a triangle must be a face of two tets of
+//! different regions; the outer boundary alone must enclose the tets' volume.
 
 use super::TetMesh;
 use crate::geom::predicates::orient3d;
@@ -23,8 +28,10 @@ pub struct Conformity {
     pub tets: usize,
     /// Faces shared by two tets.
     pub interior_faces: usize,
-    /// Faces of one tet (== boundary triangles).
+    /// Faces of one tet (== boundary triangles on the outer boundary).
     pub boundary_faces: usize,
+    /// Boundary triangles between two tets of different regions (0 for one region).
+    pub interface_faces: usize,
     /// Sum of the straight-sided tet volumes.
     pub volume_linear: f64,
     /// Volume enclosed by the flat boundary triangles.
@@ -39,8 +46,26 @@ fn bad(elements: Vec<usize>, msg: String) -> Error {
     }
 }
 
-/// Check conformity; the error names the first offending elements.
+/// Check conformity of a one-region mesh: its boundary triangles are exactly the faces
+/// of one tet. The error names the first offending elements.
 pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
+    check_conformity_regions(m, &[])
+}
+
+/// Check conformity of a mesh whose tets have region ids `regions` (one per tet; empty:
+/// one region): the faces of one tet are exactly the boundary triangles that are not
+/// interfaces, and an interface triangle is a face of two tets of different regions (a
+/// triangle between two tets of one region, such as a cavity's wall with tets inside,
+/// is an error).
+pub fn check_conformity_regions(m: &TetMesh, regions: &[i32]) -> Result<Conformity> {
+    if !regions.is_empty() && regions.len() != m.tets.len() {
+        return Err(Error::InvalidArgument(format!(
+            "{} region ids for {} tets",
+            regions.len(),
+            m.tets.len()
+        )));
+    }
+    let region = |t: usize| regions.get(t).copied().unwrap_or(0);
     let p = |i: u32| m.nodes[i as usize];
     let n = m.nodes.len() as u32;
     for (ti, t) in m.tets.iter().enumerate() {
@@ -122,7 +147,7 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
         ));
     }
     let interior = (4 * m.tets.len() - one_tet) / 2;
-    if one_tet != m.boundary.len() {
+    if one_tet > m.boundary.len() {
         return Err(bad(
             vec![],
             format!(
@@ -154,33 +179,61 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
         ));
     }
     drop(keys);
-    let bnd_err = m.boundary.par_iter().enumerate().find_map_first(|(bi, b)| {
-        let v = [b[0], b[1], b[2]];
-        if v.iter().any(|&x| x >= n) {
-            return Some(bad(
-                vec![],
-                format!("boundary triangle {bi} refers to a node out of range"),
-            ));
-        }
-        let mut holders = inc.with_face(m, v);
-        match (holders.next(), holders.next()) {
-            (Some(u), None)
-                if outward_face(&m.tets[u], v).is_some_and(|w| same_orientation(w, v)) =>
-            {
-                None
+    // Each boundary triangle: on the outer boundary (true) or an interface (false).
+    let outer: Vec<std::result::Result<bool, (usize, u32, u32)>> = m
+        .boundary
+        .par_iter()
+        .map(|b| {
+            let v = [b[0], b[1], b[2]];
+            if v.iter().any(|&x| x >= n) {
+                return Err((0, 0, 0));
             }
-            (Some(_), None) => Some(bad(
-                vec![],
-                format!("boundary triangle {bi} {v:?} is reversed in the mesh"),
-            )),
-            _ => Some(bad(
-                vec![],
-                format!("boundary triangle {bi} {v:?} is not a face of one tet"),
-            )),
-        }
-    });
-    if let Some(e) = bnd_err {
-        return Err(e);
+            let mut holders = inc.with_face(m, v);
+            match (holders.next(), holders.next()) {
+                (Some(u), None)
+                    if outward_face(&m.tets[u], v).is_some_and(|w| same_orientation(w, v)) =>
+                {
+                    Ok(true)
+                }
+                (Some(_), None) => Err((1, 0, 0)),
+                (Some(u), Some(w)) if region(u) != region(w) => Ok(false),
+                (Some(u), Some(w)) => Err((2, u as u32, w as u32)),
+                _ => Err((3, 0, 0)),
+            }
+        })
+        .collect();
+    if let Some((bi, &Err((kind, u, w)))) = outer.iter().enumerate().find(|(_, r)| r.is_err()) {
+        let b = &m.boundary[bi];
+        let v = [b[0], b[1], b[2]];
+        return Err(bad(
+            vec![],
+            match kind {
+                0 => format!("boundary triangle {bi} refers to a node out of range"),
+                1 => format!("boundary triangle {bi} {v:?} is reversed in the mesh"),
+                2 if regions.is_empty() => format!(
+                    "boundary triangle {bi} {v:?} is not a face of one tet (tets {u} and {w} \
+                     share it; as an interface between regions, give the tets region ids)"
+                ),
+                2 => format!(
+                    "boundary triangle {bi} {v:?} lies between tets {u} and {w} of one region \
+                     ({}), not between two regions",
+                    region(u as usize)
+                ),
+                _ => format!("boundary triangle {bi} {v:?} is not a face of one tet"),
+            },
+        ));
+    }
+    let outer: Vec<bool> = outer.into_iter().map(|r| r == Ok(true)).collect();
+    let n_outer = outer.iter().filter(|&&o| o).count();
+    if one_tet != n_outer {
+        return Err(bad(
+            vec![],
+            format!(
+                "the tets have {one_tet} faces of one tet, the boundary has {n_outer} \
+                 triangles on them ({} in all)",
+                m.boundary.len()
+            ),
+        ));
     }
     // One mid node per edge: every tet's equals that of the first tet holding the edge,
     // and the boundary's on boundary edges.
@@ -231,12 +284,15 @@ pub fn check_conformity(m: &TetMesh) -> Result<Conformity> {
     let enclosed_linear = compensated_sum(
         m.boundary
             .iter()
-            .map(|b| det3(sub(p(b[0]), o), sub(p(b[1]), o), sub(p(b[2]), o)) / 6.0),
+            .zip(&outer)
+            .filter(|(_, &on_outer)| on_outer)
+            .map(|(b, _)| det3(sub(p(b[0]), o), sub(p(b[1]), o), sub(p(b[2]), o)) / 6.0),
     );
     Ok(Conformity {
         tets: m.tets.len(),
         interior_faces: interior,
         boundary_faces: one_tet,
+        interface_faces: m.boundary.len() - n_outer,
         volume_linear,
         enclosed_linear,
     })

@@ -18,6 +18,9 @@ pub struct TetMesh {
     pub boundary: Vec<[u32; 6]>,
     /// One tag per boundary triangle.
     pub boundary_tags: Vec<i32>,
+    /// The volume's physical tag and the group names the writers use (from the input
+    /// surface's file; see [`crate::io::Groups`]).
+    pub groups: crate::io::Groups,
 }
 
 pub mod build;

@@ -101,6 +101,7 @@ mod tests {
                 .map(|b| [b[0], b[1], b[2], b[0], b[0], b[0]])
                 .collect(),
             boundary_tags: Vec::new(),
+            groups: Default::default(),
         }
     }
 

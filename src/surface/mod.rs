@@ -76,6 +76,8 @@ pub struct Surface {
     nodes: Vec<P3>,
     tris: Vec<[u32; 6]>,
     tags: Vec<i32>,
+    /// The volume's tag and the group names, for the writers.
+    groups: crate::io::Groups,
     warnings: Vec<String>,
     /// Sorted corner node ids.
     corners: Vec<u32>,
@@ -161,6 +163,7 @@ impl Surface {
             nodes,
             tris,
             tags,
+            groups: crate::io::Groups::default(),
             warnings,
             corners: topo.corners,
             edges,
@@ -181,6 +184,19 @@ impl Surface {
     /// One tag per triangle (Gmsh physical or entity tag; 0 when none).
     pub fn tags(&self) -> &[i32] {
         &self.tags
+    }
+
+    /// The volume's tag and the group names the mesh of this surface is written with
+    /// (default: volume [`crate::io::VOLUME_TAG`], no names).
+    pub fn groups(&self) -> &crate::io::Groups {
+        &self.groups
+    }
+
+    /// This surface with the volume tag and group names `groups` (as read from its file
+    /// by [`crate::io::read_surface`]).
+    pub fn with_groups(mut self, groups: crate::io::Groups) -> Surface {
+        self.groups = groups;
+        self
     }
     /// Warnings raised while checking (e.g. [`FLIPPED_WARNING`]).
     pub fn warnings(&self) -> &[String] {

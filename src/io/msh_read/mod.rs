@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use super::cursor::{capped, show, Cursor};
 use super::msh_types::nodes_per_element;
 use super::order::{self, Convention};
-use super::RawMesh;
+use super::{PhysicalName, RawMesh};
 use crate::error::Result;
 
 mod v2;
@@ -201,6 +201,10 @@ impl<'a> Reader<'a> {
                     }
                     self.c.expect_word("$EndElements")?;
                 }
+                b"$PhysicalNames" => {
+                    self.physical_names()?;
+                    self.c.expect_word("$EndPhysicalNames")?;
+                }
                 b"$Entities" if self.version == Version::V41 => {
                     if self.binary {
                         self.entities_binary()?
@@ -223,7 +227,40 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// Skip an unknown (or unused, like `$PhysicalNames`) section to its `$End` line.
+    /// `$PhysicalNames` (text in binary files too): a count, then `dim tag "name"` lines.
+    fn physical_names(&mut self) -> Result<()> {
+        // Each line takes at least 7 bytes (`2 1 ""` and its line break).
+        let max = (self.c.remaining() / 7) as u64;
+        let n = self.c.count("number of physical names", max)?;
+        for _ in 0..n {
+            let dim = self.c.i32("physical name dimension")?;
+            if !(0..=3).contains(&dim) {
+                return Err(self
+                    .c
+                    .err(format!("physical name dimension {dim} is not 0, 1, 2 or 3")));
+            }
+            let tag = self.c.i32("physical tag")?;
+            let line = self.c.rest_of_line();
+            let t = line.trim_ascii();
+            let name = match t {
+                [b'"', inner @ .., b'"'] => inner,
+                _ => {
+                    return Err(self.c.err(format!(
+                        "physical group {tag}: expected its name in double quotes, found '{}'",
+                        show(t)
+                    )))
+                }
+            };
+            self.mesh.physical_names.push(PhysicalName {
+                dim: dim as u8,
+                tag,
+                name: String::from_utf8_lossy(name).into_owned(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Skip an unknown section to its `$End` line.
     fn skip_section(&mut self, name: &[u8]) -> Result<()> {
         let start = self.c.pos();
         let mut pat = b"$End".to_vec();
