@@ -16,6 +16,9 @@
 //! targets: every surface meshed, corpus total at most 3x TetGen's, no surface above
 //! 10x TetGen's time + 0.5 s. Timing only; nothing is asserted (tests assert outcomes).
 
+#[path = "common/off.rs"]
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -245,29 +248,5 @@ fn main() {
 
 /// The corners of a surface as ASCII OFF, with round-trip coordinates.
 fn write_off(s: &curvetet::Surface, off: &Path) {
-    use std::fmt::Write as _;
-    let nodes = s.nodes();
-    let tris = s.triangles();
-    let mut used = vec![u32::MAX; nodes.len()];
-    let mut pts = Vec::new();
-    for t in tris {
-        for &v in &t[..3] {
-            if used[v as usize] == u32::MAX {
-                used[v as usize] = pts.len() as u32;
-                pts.push(nodes[v as usize]);
-            }
-        }
-    }
-    let mut o = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
-    for p in &pts {
-        let _ = writeln!(o, "{:e} {:e} {:e}", p[0], p[1], p[2]);
-    }
-    for t in tris {
-        let _ = writeln!(
-            o,
-            "3 {} {} {}",
-            used[t[0] as usize], used[t[1] as usize], used[t[2] as usize]
-        );
-    }
-    std::fs::write(off, o).expect("off");
+    std::fs::write(off, common::linear_off(s)).expect("off");
 }

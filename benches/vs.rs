@@ -24,6 +24,9 @@
 //! Ratios are curvetet/tool for wall time, and for time per tet (the tools make different
 //! numbers of tets from the same surface). Timing only; nothing is asserted.
 
+#[path = "common/off.rs"]
+mod common;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -234,20 +237,7 @@ fn have(tool: &str) -> bool {
 fn write_linear(s: &curvetet::Surface, off: &Path, stl: &Path) -> f64 {
     let nodes = s.nodes();
     let tris = s.triangles();
-    let mut used = vec![u32::MAX; nodes.len()];
-    let mut pts = Vec::new();
-    for t in tris {
-        for &v in &t[..3] {
-            if used[v as usize] == u32::MAX {
-                used[v as usize] = pts.len() as u32;
-                pts.push(nodes[v as usize]);
-            }
-        }
-    }
-    let mut o = format!("OFF\n{} {} 0\n", pts.len(), tris.len());
-    for p in &pts {
-        let _ = writeln!(o, "{:e} {:e} {:e}", p[0], p[1], p[2]);
-    }
+    let o = common::linear_off(s);
     let mut st = String::from("solid twin\n");
     let mut vol = 0.0;
     for t in tris {
@@ -256,11 +246,6 @@ fn write_linear(s: &curvetet::Surface, off: &Path, stl: &Path) -> f64 {
             + a[1] * (b[2] * c[0] - b[0] * c[2])
             + a[2] * (b[0] * c[1] - b[1] * c[0]))
             / 6.0;
-        let _ = writeln!(
-            o,
-            "3 {} {} {}",
-            used[t[0] as usize], used[t[1] as usize], used[t[2] as usize]
-        );
         st += "facet normal 0 0 0\nouter loop\n";
         for &v in &t[..3] {
             let p = nodes[v as usize];
