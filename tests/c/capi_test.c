@@ -701,6 +701,23 @@ int main(int argc, char **argv) {
     CHECK(curvetet_surface_warning(s3, 0) != NULL &&
           strstr(curvetet_surface_warning(s3, 0), "flipped") != NULL);
     curvetet_surface_free(s3);
+    /* Only the first triangle flipped: reoriented with a warning, or refused when strict. */
+    memcpy(flipped + 6, sa.tri + 6, 6 * (sa.nt - 1) * sizeof(uint32_t));
+    s3 = NULL;
+    EXPECT_STATUS(curvetet_surface_from_arrays_with_flags(sa.xyz, sa.nn, flipped, sa.nt, NULL,
+                                                          0, &s3),
+                  CURVETET_OK);
+    REQUIRE(s3 != NULL);
+    CHECK(curvetet_surface_num_warnings(s3) == 1);
+    CHECK(curvetet_surface_warning(s3, 0) != NULL &&
+          strstr(curvetet_surface_warning(s3, 0), "flipped 1 of") != NULL);
+    curvetet_surface_free(s3);
+    s3 = NULL;
+    EXPECT_STATUS(curvetet_surface_from_arrays_with_flags(sa.xyz, sa.nn, flipped, sa.nt, NULL,
+                                                          CURVETET_SURFACE_STRICT, &s3),
+                  CURVETET_ERR_INVALID_SURFACE);
+    CHECK(s3 == NULL);
+    CHECK(strstr(curvetet_last_error_message(), "inconsistent-orientation") != NULL);
     free(flipped);
 
     /* Round trips through the writers. */
