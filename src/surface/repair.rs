@@ -6,7 +6,7 @@
 //! - **Inconsistent orientation**: on a closed manifold surface (every edge used by exactly
 //!   two triangles) each shell has exactly two consistent orientations. A breadth-first
 //!   walk over edge adjacency flips a triangle whenever it runs a shared edge in the same
-//!   direction as the triangle it was reached from ([`consistent_flips`]); the shell then
+//!   direction as the triangle it was reached from (`consistent_flips`); the shell then
 //!   agrees with its first triangle. Which of the two orientations is outward is decided
 //!   afterwards, per shell, by the exact enclosed volume and nesting depth of
 //!   [`orientation`](super::orientation) (the outer shell faces out, a cavity's shell
@@ -189,7 +189,7 @@ pub(crate) fn consistent_flips<const N: usize>(tris: &[[u32; N]]) -> Option<Vec<
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// The tetrahedron (0, 1, 2, 3), outward.
@@ -216,6 +216,25 @@ mod tests {
         tris.push([0, 1, 4]);
         tris.push([0, 4, 1]);
         assert_eq!(consistent_flips(&tris), None);
+    }
+
+    /// The 6-vertex projective plane: closed, every edge used twice, non-orientable.
+    pub(crate) const RP2: [[u32; 3]; 10] = [
+        [0, 1, 2],
+        [0, 2, 3],
+        [0, 3, 4],
+        [0, 4, 5],
+        [0, 5, 1],
+        [1, 2, 4],
+        [2, 3, 5],
+        [3, 4, 1],
+        [4, 5, 2],
+        [5, 1, 3],
+    ];
+
+    #[test]
+    fn a_non_orientable_surface_is_left_alone() {
+        assert_eq!(consistent_flips(&RP2), None);
     }
 
     #[test]

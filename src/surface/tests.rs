@@ -965,6 +965,29 @@ fn unused_nodes_are_dropped() {
 }
 
 #[test]
+fn a_non_orientable_surface_stays_an_error() {
+    // The 6-vertex projective plane (on vertices in general position): every edge used
+    // twice, no consistent orientation. Refused as before, repair or not.
+    let v = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.1, 0.2],
+        [0.3, 1.0, 0.1],
+        [0.2, 0.4, 1.0],
+        [1.1, 1.2, 0.3],
+        [0.5, -0.7, 0.9],
+    ];
+    let s = P2::new(&v, &super::repair::tests::RP2, mid);
+    let (kind, msg) = s.defect();
+    assert_eq!(kind, SurfaceDefect::InconsistentOrientation, "{msg}");
+    let e = s.check().expect_err("refused");
+    assert_eq!(
+        e.surface_defect(),
+        Some(SurfaceDefect::InconsistentOrientation)
+    );
+    assert!(e.to_string().contains("same direction"), "{e}");
+}
+
+#[test]
 fn clean_surfaces_are_not_touched() {
     // Nothing to repair: the very triangles, no warning (strict or not).
     for s in [octahedron(1.0), icosahedron(), cube()] {
