@@ -155,6 +155,19 @@ impl Surface {
                 (nodes, tris) = (kept, renumbered);
             }
         }
+        let dropped = done.dropped_note();
+        Surface::checked(nodes, tris, tags, repair, done).map_err(|e| dropped.explain(e))
+    }
+
+    /// The checks of [`Surface::build`] after the indices (and the dropping of unused
+    /// nodes).
+    fn checked(
+        nodes: Vec<P3>,
+        mut tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        repair: Repair,
+        mut done: repair::Done,
+    ) -> Result<Surface> {
         coords::check_coordinates(&nodes)?;
         indices::check_unused(nodes.len(), &tris, &nodes)?;
         coords::check_duplicates(&nodes)?;

@@ -17,6 +17,7 @@
 //! stays an error. Both repairs run only where the strict checks would fail, so a clean
 //! input goes through exactly as before: same nodes, same triangles, no warning.
 
+use crate::error::Error;
 use std::collections::VecDeque;
 
 /// Whether building a [`Surface`](super::Surface) repairs what is unambiguous in its
@@ -69,6 +70,11 @@ impl Done {
         })
     }
 
+    /// What [`DroppedNote::explain`] needs to say about the dropped nodes.
+    pub fn dropped_note(&self) -> DroppedNote {
+        DroppedNote(self.dropped.map(|(n, _, what)| (n, what)))
+    }
+
     /// Record the flips `f` (one flag per triangle) on top of earlier ones.
     pub fn add_flips(&mut self, f: &[bool]) {
         if self.flipped.is_empty() {
@@ -77,6 +83,32 @@ impl Done {
             for (a, &b) in self.flipped.iter_mut().zip(f) {
                 *a ^= b;
             }
+        }
+    }
+}
+
+/// How many nodes were dropped, and what the input calls them, if any were.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct DroppedNote(Option<(usize, &'static str)>);
+
+impl DroppedNote {
+    /// A surface error found after unused nodes were dropped names nodes by their new
+    /// numbers: say so, so that the numbers are not taken for the file's.
+    pub fn explain(self, e: Error) -> Error {
+        match (self.0, e) {
+            (Some((n, what)), Error::InvalidSurface { kind, msg }) => {
+                let note = format!(
+                    " ({what} numbered after dropping the {n} that no triangle uses; \
+                     `--strict` keeps the input's numbers)"
+                );
+                let msg = if msg.ends_with(&note) {
+                    msg
+                } else {
+                    msg + &note
+                };
+                Error::InvalidSurface { kind, msg }
+            }
+            (_, e) => e,
         }
     }
 }

@@ -988,6 +988,35 @@ fn a_non_orientable_surface_stays_an_error() {
 }
 
 #[test]
+fn errors_after_dropping_unused_nodes_say_the_numbers_changed() {
+    let mut s = octahedron(1.0);
+    s.nodes.insert(0, [7.0, 0.0, 0.0]);
+    for t in &mut s.tris {
+        *t = t.map(|v| v + 1);
+    }
+    s.tris.remove(3);
+    let e = s.check().expect_err("open");
+    assert_eq!(e.surface_defect(), Some(SurfaceDefect::NotClosed));
+    let note = " (nodes numbered after dropping the 1 that no triangle uses; `--strict` keeps \
+                the input's numbers)";
+    assert!(e.to_string().ends_with(note), "{e}");
+    assert_eq!(e.to_string().matches("numbered after").count(), 1, "{e}");
+    // Strict: the unused node first, in the input's numbers.
+    assert_eq!(s.defect().0, SurfaceDefect::UnusedNode);
+    // Linear: the same, once.
+    let tri3: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[1], t[2]]).collect();
+    let nodes = s.nodes.clone();
+    let e = Surface::from_linear(nodes, tri3, vec![], 40.0).expect_err("open");
+    assert_eq!(e.surface_defect(), Some(SurfaceDefect::NotClosed));
+    assert!(
+        e.to_string()
+            .contains("vertices numbered after dropping the"),
+        "{e}"
+    );
+    assert_eq!(e.to_string().matches("numbered after").count(), 1, "{e}");
+}
+
+#[test]
 fn clean_surfaces_are_not_touched() {
     // Nothing to repair: the very triangles, no warning (strict or not).
     for s in [octahedron(1.0), icosahedron(), cube()] {

@@ -231,6 +231,18 @@ pub fn curve_linear_report(
             (nodes, tri3) = (kept, renumbered);
         }
     }
+    let dropped = done.dropped_note();
+    curve_checked(nodes, tri3, tags, opts, done).map_err(|e| dropped.explain(e))
+}
+
+/// [`curve_linear_report`] after the unused vertices were dropped (`done`).
+fn curve_checked(
+    nodes: Vec<P3>,
+    mut tri3: Vec<[u32; 3]>,
+    tags: Vec<i32>,
+    opts: &CurveOptions,
+    mut done: Done,
+) -> Result<(Surface, CurveReport)> {
     let nodes = if opts.smooth_iterations > 0 {
         // Smooth the checked surface, then check the smoothed one (it must still be a
         // valid surface: no fold, no self-intersection).
