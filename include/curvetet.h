@@ -70,6 +70,15 @@
 #define CURVETET_WRITE_MEDIT_LINEAR 4
 
 /**
+ * Flag of the `curvetet_surface_*_with_flags` functions: refuse a surface whose
+ * triangles are inconsistently oriented (status `CURVETET_ERR_INVALID_SURFACE`, kind
+ * inconsistent-orientation) or that has nodes no triangle uses (unused-node), instead of
+ * reorienting the triangles or dropping the nodes with a warning (the default). A
+ * consistently inside-out surface is still flipped, with a warning.
+ */
+#define CURVETET_SURFACE_STRICT 1
+
+/**
  * The result of every fallible curvetet call. `CURVETET_OK` (0) is success; on any
  * other value `curvetet_last_error_message()` says what went wrong.
  */
@@ -504,7 +513,10 @@ double curvetet_mesh_target_size(const struct curvetet_mesh *m);
  * - `tri6`: `6 * num_triangles` 0-based node indices per triangle, corners first, then
  *   the mid-edge nodes of edges (0,1), (1,2), (2,0) (Gmsh's and VTK's order), outward
  *   (right-hand rule). A consistently inward surface is flipped, with a warning (see
- *   `curvetet_surface_num_warnings`).
+ *   `curvetet_surface_num_warnings`); so are inconsistently oriented triangles, and
+ *   nodes no triangle uses are dropped (the others renumbered), each with a warning
+ *   (`curvetet_surface_from_arrays_with_flags` with `CURVETET_SURFACE_STRICT` refuses
+ *   both).
  * - `tags`: `num_triangles` tags (e.g. Gmsh physical tags) kept on the boundary of the
  *   mesh, or NULL for all 0.
  *
@@ -526,12 +538,31 @@ enum curvetet_status curvetet_surface_from_arrays(const double *xyz,
                                                   struct curvetet_surface **out);
 
 /**
+ * `curvetet_surface_from_arrays` with `flags`: 0, or `CURVETET_SURFACE_STRICT`.
+ * Statuses as `curvetet_surface_from_arrays`, and `CURVETET_ERR_INVALID_ARGUMENT` for
+ * unknown flag bits.
+ *
+ * # Safety
+ * As `curvetet_surface_from_arrays`.
+ */
+enum curvetet_status curvetet_surface_from_arrays_with_flags(const double *xyz,
+                                                             size_t num_nodes,
+                                                             const uint32_t *tri6,
+                                                             size_t num_triangles,
+                                                             const int32_t *tags,
+                                                             uint32_t flags,
+                                                             struct curvetet_surface **out);
+
+/**
  * Build a surface from a closed *linear* (3-node) triangle mesh: it is checked like a
  * P2 surface (closed, manifold, oriented, no zero-area facet, no self-intersection),
  * then curved (each edge gets a mid node on a smooth reconstruction; edges sharper than
  * `feature_angle_deg` are features whose mid nodes follow the feature curve; flat
  * regions stay flat; no curved triangle folds). The input vertices keep their indices
- * and exact coordinates; mid nodes are appended after them.
+ * and exact coordinates; mid nodes are appended after them. Inconsistently oriented
+ * facets are flipped and unused vertices dropped (the others renumbered), each with a
+ * warning (`curvetet_surface_from_linear_with_flags` with `CURVETET_SURFACE_STRICT`
+ * refuses both).
  *
  * - `xyz`: `3 * num_nodes` coordinates; `tri3`: `3 * num_triangles` 0-based corners,
  *   outward; `tags`: `num_triangles` tags or NULL; `feature_angle_deg`: e.g. 40
@@ -576,6 +607,26 @@ enum curvetet_status curvetet_surface_from_linear_smoothed(const double *xyz,
                                                            struct curvetet_surface **out);
 
 /**
+ * `curvetet_surface_from_linear_smoothed` with `flags`: 0, or
+ * `CURVETET_SURFACE_STRICT` (refuse inconsistently oriented facets and unused vertices
+ * rather than flip and drop them with a warning). Statuses as
+ * `curvetet_surface_from_linear`, and `CURVETET_ERR_INVALID_ARGUMENT` for unknown flag
+ * bits.
+ *
+ * # Safety
+ * As `curvetet_surface_from_linear`.
+ */
+enum curvetet_status curvetet_surface_from_linear_with_flags(const double *xyz,
+                                                             size_t num_nodes,
+                                                             const uint32_t *tri3,
+                                                             size_t num_triangles,
+                                                             const int32_t *tags,
+                                                             double feature_angle_deg,
+                                                             uint32_t smooth_iterations,
+                                                             uint32_t flags,
+                                                             struct curvetet_surface **out);
+
+/**
  * Read a surface from a file, by extension: a P2 surface from Gmsh `.msh` (2.2/4.1,
  * ASCII/binary), VTK `.vtu`/`.vtk` or medit `.mesh`; or a linear one from `.stl`,
  * `.off`, `.obj`, `.ply` (or 3-node triangles in the formats above), which is curved as
@@ -593,6 +644,19 @@ enum curvetet_status curvetet_surface_from_linear_smoothed(const double *xyz,
  * `path` must be NULL or a NUL-terminated string.
  */
 enum curvetet_status curvetet_surface_read(const char *path, struct curvetet_surface **out);
+
+/**
+ * `curvetet_surface_read` with `flags`: 0, or `CURVETET_SURFACE_STRICT` (refuse
+ * inconsistently oriented triangles and unused nodes rather than flip and drop them
+ * with a warning). Statuses as `curvetet_surface_read`, and
+ * `CURVETET_ERR_INVALID_ARGUMENT` for unknown flag bits.
+ *
+ * # Safety
+ * As `curvetet_surface_read`.
+ */
+enum curvetet_status curvetet_surface_read_with_flags(const char *path,
+                                                      uint32_t flags,
+                                                      struct curvetet_surface **out);
 
 /**
  * Free a surface. NULL is fine. Meshes generated from it stay valid (they own their

@@ -19,7 +19,8 @@ pub enum SurfaceDefect {
     CoordinateRange,
     /// Two nodes have identical coordinates.
     DuplicateNode,
-    /// A node is used by no triangle.
+    /// A node is used by no triangle (dropped with a warning unless
+    /// [`Repair::Strict`](crate::surface::Repair::Strict)).
     UnusedNode,
     /// An edge belongs to only one triangle.
     NotClosed,
@@ -27,7 +28,9 @@ pub enum SurfaceDefect {
     NonManifoldEdge,
     /// The triangles around a vertex form more than one fan.
     NonManifoldVertex,
-    /// Neighbouring triangles have opposite orientations (or the shells disagree).
+    /// Neighbouring triangles have opposite orientations (or the shells disagree); on a
+    /// closed manifold orientable surface reoriented with a warning unless
+    /// [`Repair::Strict`](crate::surface::Repair::Strict).
     InconsistentOrientation,
     /// Two triangles share an edge but not its mid-edge node, a mid node is shared wrongly,
     /// or a mid node lies more than an edge length from its edge's midpoint.

@@ -92,7 +92,7 @@ fn check_rejects_each_bad_file_with_its_defect() {
         let (file, kind) = (it.next().unwrap(), it.next().unwrap());
         let path = data(&format!("bad/{file}"));
         let t = Instant::now();
-        let out = run(&["check", path.to_str().unwrap()]);
+        let out = run(&["check", path.to_str().unwrap(), "--strict"]);
         assert!(t.elapsed() < Duration::from_secs(10), "{file}: too slow");
         let code = out
             .status
@@ -103,6 +103,19 @@ fn check_rejects_each_bad_file_with_its_defect() {
         assert!(code == 4 || code == 3, "{file}: exit {code}: {err}");
         if code == 4 {
             assert!(err.contains(kind), "{file}: expected {kind}, got: {err}");
+        }
+        // Without --strict, unused nodes and orientation are repaired with a warning;
+        // everything else is refused the same way.
+        let lenient = run(&["check", path.to_str().unwrap()]);
+        let lerr = String::from_utf8_lossy(&lenient.stderr);
+        if code == 4 && (kind == "unused-node" || kind == "inconsistent-orientation") {
+            assert!(lenient.status.success(), "{file}: {lerr}");
+            assert!(lerr.contains("warning: "), "{file}: {lerr}");
+        } else {
+            assert_eq!(lenient.status.code(), Some(code), "{file}: {lerr}");
+            if code == 4 {
+                assert!(lerr.contains(kind), "{file}: expected {kind}, got: {lerr}");
+            }
         }
         n += 1;
     }

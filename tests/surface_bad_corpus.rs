@@ -3,25 +3,94 @@
 //! an element (triangle, edge or node) or says why the whole model is rejected. P2 files
 //! (.msh) go to `Surface::new`; linear files (.off, .stl) go through the real readers to
 //! `Surface::from_linear`, and must give the same kinds as their P2 counterparts. Each case
-//! must finish within 10 s (a hang guard).
+//! must finish within 10 s (a hang guard). The kinds are those of the strict checks
+//! (`Repair::Strict`, `--strict`); by default the files whose only defect is unused nodes
+//! or orientation are repaired with a warning, and every other file is refused with the
+//! same kind as under strict.
 
 mod common;
 
 use common::{data_dir, read_msh41};
+use curvetet::surface::curve::{curve_linear, CurveOptions};
+use curvetet::surface::Repair;
 use curvetet::{io, Error, Result, Surface};
 
-/// The surface a corpus file makes: P2 files through `Surface::new`, linear ones through
-/// the product's reader and `Surface::from_linear`.
-fn corpus_surface(path: &std::path::Path) -> Result<Surface> {
+/// The corpus files that are repaired (with one warning) unless strict.
+const REPAIRED: [&str; 5] = [
+    "unused_node.msh",
+    "flipped_triangle.msh",
+    "shells_disagree.msh",
+    "flipped_lin.off",
+    "unused_vertex_lin.off",
+];
+
+/// The surface a corpus file makes: P2 files through `Surface::new_with_repair`, linear
+/// ones through the product's reader and `curve_linear` (as `Surface::from_linear`).
+fn corpus_surface_with(path: &std::path::Path, repair: Repair) -> Result<Surface> {
     let name = path.file_name().unwrap().to_str().unwrap();
     if name.ends_with(".msh") {
         let m = read_msh41(path);
-        Surface::new(m.nodes, m.tris, m.tags)
+        Surface::new_with_repair(m.nodes, m.tris, m.tags, repair)
     } else {
         let raw = io::read(path).unwrap_or_else(|e| panic!("{name}: the reader failed: {e}"));
         assert!(raw.tri6.is_empty(), "{name}: not a linear file");
-        Surface::from_linear(raw.nodes, raw.tri3, raw.tri3_tags, 40.0)
+        let opts = CurveOptions {
+            repair,
+            ..CurveOptions::with_feature_angle(40.0)
+        };
+        curve_linear(raw.nodes, raw.tri3, raw.tri3_tags, &opts)
     }
+}
+
+/// [`corpus_surface_with`] under the strict checks.
+fn corpus_surface(path: &std::path::Path) -> Result<Surface> {
+    corpus_surface_with(path, Repair::Strict)
+}
+
+#[test]
+fn default_repairs_only_orientation_and_unused_nodes() {
+    let dir = data_dir().join("bad");
+    let expected = std::fs::read_to_string(dir.join("EXPECTED.txt")).unwrap();
+    let mut repaired = 0;
+    for line in expected.lines().filter(|l| !l.trim().is_empty()) {
+        let (file, kind) = line.split_once(' ').expect("`filename kind-name`");
+        match corpus_surface_with(&dir.join(file), Repair::Unambiguous) {
+            Ok(s) => {
+                assert!(REPAIRED.contains(&file), "{file} ({kind}) was accepted");
+                let w = s.warnings();
+                assert_eq!(w.len(), 1, "{file}: {w:?}");
+                let what = if kind == "unused-node" {
+                    "used by no triangle: dropped"
+                } else {
+                    "orientation was inconsistent: flipped"
+                };
+                assert!(w[0].contains(what), "{file}: {w:?}");
+                // The repaired surface passes the strict checks as it is.
+                let again = Surface::new_with_repair(
+                    s.nodes().to_vec(),
+                    s.triangles().to_vec(),
+                    s.tags().to_vec(),
+                    Repair::Strict,
+                )
+                .unwrap_or_else(|e| panic!("{file}: {e}"));
+                assert!(
+                    again.warnings().is_empty(),
+                    "{file}: {:?}",
+                    again.warnings()
+                );
+                repaired += 1;
+            }
+            Err(e) => {
+                assert!(!REPAIRED.contains(&file), "{file}: not repaired: {e}");
+                assert_eq!(
+                    e.surface_defect().map(|k| k.name()),
+                    Some(kind),
+                    "{file}: {e}"
+                );
+            }
+        }
+    }
+    assert_eq!(repaired, REPAIRED.len());
 }
 
 #[test]

@@ -10,6 +10,7 @@ use curvetet::surface::curve::{curve_linear_report, CurveOptions, CurveReport};
 use curvetet::surface::geometry::{
     triangle_shape, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
 };
+use curvetet::surface::Repair;
 use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{IsTerminal, Write};
@@ -174,13 +175,26 @@ struct CurveArgs {
     /// surface (by a fraction of a voxel) and rounds sharp edges. At most 1000
     #[arg(long, default_value_t = 0)]
     smooth: u32,
+    /// Refuse a surface with inconsistently oriented triangles or unused vertices (by
+    /// default they are reoriented or dropped, with a warning)
+    #[arg(long)]
+    strict: bool,
 }
 
 impl CurveArgs {
     fn options(&self) -> CurveOptions {
         CurveOptions {
             smooth_iterations: self.smooth,
+            repair: self.repair(),
             ..CurveOptions::with_feature_angle(self.feature_angle)
+        }
+    }
+
+    fn repair(&self) -> Repair {
+        if self.strict {
+            Repair::Strict
+        } else {
+            Repair::Unambiguous
         }
     }
 }
@@ -549,7 +563,7 @@ fn read_surface_any(path: &Path, c: &CurveArgs) -> Result<Surface, Error> {
     let raw = io::read(path)?;
     let name = path.display().to_string();
     if !raw.tri6.is_empty() || raw.tri3.is_empty() {
-        return io::surface_from_raw(raw, &name);
+        return io::surface_from_raw_with_repair(raw, &name, c.repair());
     }
     let (s, r) = curve_raw(raw, &name, c)?;
     eprintln!("{}", curve_summary(&name, &s, &r));
@@ -780,6 +794,9 @@ fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> 
     let raw = io::read(input)?;
     if raw.tet10.is_empty() {
         let s = io::surface_from_raw(raw, &input.display().to_string())?;
+        for w in s.warnings() {
+            eprintln!("warning: {w}");
+        }
         io::write_surface(output, s.nodes(), s.triangles(), s.tags(), &w.options())?;
     } else {
         let m = raw.into_tet_mesh()?;
@@ -875,7 +892,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
         return Ok(());
     }
     if raw.tet10.is_empty() && raw.tet4.is_empty() {
-        let s = io::surface_from_raw(raw, &name)?;
+        let s = io::surface_from_raw_with_repair(raw, &name, c.repair())?;
         for w in s.warnings() {
             eprintln!("warning: {w}");
         }

@@ -39,9 +39,11 @@ pub use options::{
 };
 pub use status::{curvetet_status, StatusArg};
 pub use surface::{
-    curvetet_surface, curvetet_surface_free, curvetet_surface_from_arrays, curvetet_surface_nodes,
-    curvetet_surface_num_nodes, curvetet_surface_num_triangles, curvetet_surface_num_warnings,
-    curvetet_surface_read, curvetet_surface_triangles, curvetet_surface_warning,
+    curvetet_surface, curvetet_surface_free, curvetet_surface_from_arrays,
+    curvetet_surface_from_arrays_with_flags, curvetet_surface_from_linear_with_flags,
+    curvetet_surface_nodes, curvetet_surface_num_nodes, curvetet_surface_num_triangles,
+    curvetet_surface_num_warnings, curvetet_surface_read, curvetet_surface_read_with_flags,
+    curvetet_surface_triangles, curvetet_surface_warning, CURVETET_SURFACE_STRICT,
 };
 
 use guard::{check_ptr, status_call, value_call};

@@ -5,6 +5,7 @@ use super::guard::{
     times, value_call,
 };
 use super::status::curvetet_status;
+use crate::surface::Repair;
 use crate::{Result, Surface};
 use std::ffi::{c_char, CStr, CString};
 use std::path::PathBuf;
@@ -82,7 +83,10 @@ pub(crate) unsafe fn c_path(path: *const c_char) -> Result<PathBuf> {
 /// - `tri6`: `6 * num_triangles` 0-based node indices per triangle, corners first, then
 ///   the mid-edge nodes of edges (0,1), (1,2), (2,0) (Gmsh's and VTK's order), outward
 ///   (right-hand rule). A consistently inward surface is flipped, with a warning (see
-///   `curvetet_surface_num_warnings`).
+///   `curvetet_surface_num_warnings`); so are inconsistently oriented triangles, and
+///   nodes no triangle uses are dropped (the others renumbered), each with a warning
+///   (`curvetet_surface_from_arrays_with_flags` with `CURVETET_SURFACE_STRICT` refuses
+///   both).
 /// - `tags`: `num_triangles` tags (e.g. Gmsh physical tags) kept on the boundary of the
 ///   mesh, or NULL for all 0.
 ///
@@ -104,7 +108,37 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
     tags: *const i32,
     out: *mut *mut curvetet_surface,
 ) -> curvetet_status {
-    status_call("curvetet_surface_from_arrays", || {
+    // SAFETY: forwarded as documented.
+    unsafe {
+        from_arrays_call(
+            "curvetet_surface_from_arrays",
+            xyz,
+            num_nodes,
+            tri6,
+            num_triangles,
+            tags,
+            0,
+            out,
+        )
+    }
+}
+
+/// The body of the two `curvetet_surface_from_arrays*` functions.
+///
+/// # Safety
+/// As `curvetet_surface_from_arrays`.
+#[allow(clippy::too_many_arguments)] // the C function's arguments, forwarded
+unsafe fn from_arrays_call(
+    name: &str,
+    xyz: *const f64,
+    num_nodes: usize,
+    tri6: *const u32,
+    num_triangles: usize,
+    tags: *const i32,
+    flags: u32,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    status_call(name, || {
         // SAFETY: `out` is the caller's; checked inside.
         unsafe { reset_out(out)? };
         check_counts(num_nodes, num_triangles)?;
@@ -120,11 +154,63 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
         };
         let nodes: Vec<[f64; 3]> = copy_groups(xyz, "xyz")?;
         let tris: Vec<[u32; 6]> = copy_groups(tri6, "tri6")?;
-        let s = Surface::new(nodes, tris, tags)?;
+        let s = Surface::new_with_repair(nodes, tris, tags, repair_of(flags)?)?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };
         Ok(())
     })
+}
+
+/// Flag of the `curvetet_surface_*_with_flags` functions: refuse a surface whose
+/// triangles are inconsistently oriented (status `CURVETET_ERR_INVALID_SURFACE`, kind
+/// inconsistent-orientation) or that has nodes no triangle uses (unused-node), instead of
+/// reorienting the triangles or dropping the nodes with a warning (the default). A
+/// consistently inside-out surface is still flipped, with a warning.
+pub const CURVETET_SURFACE_STRICT: u32 = 1;
+
+/// The repair policy `flags` (of `curvetet_surface_*_with_flags`) ask for; unknown bits
+/// are an error.
+fn repair_of(flags: u32) -> Result<Repair> {
+    let known = CURVETET_SURFACE_STRICT;
+    if flags & !known != 0 {
+        return Err(invalid(format!("unknown flag bits {:#x}", flags & !known)));
+    }
+    Ok(if flags & CURVETET_SURFACE_STRICT != 0 {
+        Repair::Strict
+    } else {
+        Repair::Unambiguous
+    })
+}
+
+/// `curvetet_surface_from_arrays` with `flags`: 0, or `CURVETET_SURFACE_STRICT`.
+/// Statuses as `curvetet_surface_from_arrays`, and `CURVETET_ERR_INVALID_ARGUMENT` for
+/// unknown flag bits.
+///
+/// # Safety
+/// As `curvetet_surface_from_arrays`.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_from_arrays_with_flags(
+    xyz: *const f64,
+    num_nodes: usize,
+    tri6: *const u32,
+    num_triangles: usize,
+    tags: *const i32,
+    flags: u32,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    // SAFETY: forwarded as documented.
+    unsafe {
+        from_arrays_call(
+            "curvetet_surface_from_arrays_with_flags",
+            xyz,
+            num_nodes,
+            tri6,
+            num_triangles,
+            tags,
+            flags,
+            out,
+        )
+    }
 }
 
 /// Build a surface from a closed *linear* (3-node) triangle mesh: it is checked like a
@@ -132,7 +218,10 @@ pub unsafe extern "C" fn curvetet_surface_from_arrays(
 /// then curved (each edge gets a mid node on a smooth reconstruction; edges sharper than
 /// `feature_angle_deg` are features whose mid nodes follow the feature curve; flat
 /// regions stay flat; no curved triangle folds). The input vertices keep their indices
-/// and exact coordinates; mid nodes are appended after them.
+/// and exact coordinates; mid nodes are appended after them. Inconsistently oriented
+/// facets are flipped and unused vertices dropped (the others renumbered), each with a
+/// warning (`curvetet_surface_from_linear_with_flags` with `CURVETET_SURFACE_STRICT`
+/// refuses both).
 ///
 /// - `xyz`: `3 * num_nodes` coordinates; `tri3`: `3 * num_triangles` 0-based corners,
 ///   outward; `tags`: `num_triangles` tags or NULL; `feature_angle_deg`: e.g. 40
@@ -166,6 +255,7 @@ pub unsafe extern "C" fn curvetet_surface_from_linear(
             num_triangles,
             tags,
             feature_angle_deg,
+            0,
             0,
             out,
         )
@@ -204,6 +294,45 @@ pub unsafe extern "C" fn curvetet_surface_from_linear_smoothed(
             tags,
             feature_angle_deg,
             smooth_iterations,
+            0,
+            out,
+        )
+    }
+}
+
+/// `curvetet_surface_from_linear_smoothed` with `flags`: 0, or
+/// `CURVETET_SURFACE_STRICT` (refuse inconsistently oriented facets and unused vertices
+/// rather than flip and drop them with a warning). Statuses as
+/// `curvetet_surface_from_linear`, and `CURVETET_ERR_INVALID_ARGUMENT` for unknown flag
+/// bits.
+///
+/// # Safety
+/// As `curvetet_surface_from_linear`.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)] // the C function's arguments
+pub unsafe extern "C" fn curvetet_surface_from_linear_with_flags(
+    xyz: *const f64,
+    num_nodes: usize,
+    tri3: *const u32,
+    num_triangles: usize,
+    tags: *const i32,
+    feature_angle_deg: f64,
+    smooth_iterations: u32,
+    flags: u32,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    // SAFETY: forwarded as documented.
+    unsafe {
+        from_linear_call(
+            "curvetet_surface_from_linear_with_flags",
+            xyz,
+            num_nodes,
+            tri3,
+            num_triangles,
+            tags,
+            feature_angle_deg,
+            smooth_iterations,
+            flags,
             out,
         )
     }
@@ -223,6 +352,7 @@ unsafe fn from_linear_call(
     tags: *const i32,
     feature_angle_deg: f64,
     smooth_iterations: u32,
+    flags: u32,
     out: *mut *mut curvetet_surface,
 ) -> curvetet_status {
     status_call(name, || {
@@ -243,6 +373,7 @@ unsafe fn from_linear_call(
         let tris: Vec<[u32; 3]> = copy_groups(tri3, "tri3")?;
         let opts = crate::surface::curve::CurveOptions {
             smooth_iterations,
+            repair: repair_of(flags)?,
             ..crate::surface::curve::CurveOptions::with_feature_angle(feature_angle_deg)
         };
         let s = crate::surface::curve::curve_linear(nodes, tris, tags, &opts)?;
@@ -272,13 +403,47 @@ pub unsafe extern "C" fn curvetet_surface_read(
     path: *const c_char,
     out: *mut *mut curvetet_surface,
 ) -> curvetet_status {
-    status_call("curvetet_surface_read", || {
+    // SAFETY: forwarded as documented.
+    unsafe { read_call("curvetet_surface_read", path, 0, out) }
+}
+
+/// `curvetet_surface_read` with `flags`: 0, or `CURVETET_SURFACE_STRICT` (refuse
+/// inconsistently oriented triangles and unused nodes rather than flip and drop them
+/// with a warning). Statuses as `curvetet_surface_read`, and
+/// `CURVETET_ERR_INVALID_ARGUMENT` for unknown flag bits.
+///
+/// # Safety
+/// As `curvetet_surface_read`.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_read_with_flags(
+    path: *const c_char,
+    flags: u32,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    // SAFETY: forwarded as documented.
+    unsafe { read_call("curvetet_surface_read_with_flags", path, flags, out) }
+}
+
+/// The body of the two `curvetet_surface_read*` functions.
+///
+/// # Safety
+/// As `curvetet_surface_read`.
+unsafe fn read_call(
+    name: &str,
+    path: *const c_char,
+    flags: u32,
+    out: *mut *mut curvetet_surface,
+) -> curvetet_status {
+    status_call(name, || {
         // SAFETY: checked inside.
         unsafe { reset_out(out)? };
+        let opts = crate::surface::curve::CurveOptions {
+            repair: repair_of(flags)?,
+            ..crate::surface::curve::CurveOptions::default()
+        };
         // SAFETY: NUL-terminated by contract.
         let path = unsafe { c_path(path)? };
-        let s =
-            crate::io::read_any_surface(&path, &crate::surface::curve::CurveOptions::default())?;
+        let s = crate::io::read_any_surface(&path, &opts)?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };
         Ok(())

@@ -599,3 +599,118 @@ fn a_caught_panic_names_its_location_and_prints_nothing() {
         "{err}"
     );
 }
+
+/// `CURVETET_SURFACE_STRICT` refuses what the default repairs: a P2 surface with a
+/// flipped triangle and an unused node, a linear one with a flipped facet, a file with
+/// the cavity facing the wrong way; unknown flag bits are an argument error.
+#[test]
+fn the_strict_flag_refuses_what_is_repaired_by_default() {
+    use super::surface::curvetet_surface_free;
+    let raw = crate::io::read(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/sphere_p2.msh"
+    )))
+    .unwrap();
+    let (nodes, tris) = (raw.nodes, raw.tri6);
+    let mut xyz: Vec<f64> = nodes.iter().flatten().copied().collect();
+    xyz.extend([9.0, 9.0, 9.0]); // an unused node
+    let mut tri6: Vec<u32> = tris.iter().flatten().copied().collect();
+    let t = &mut tri6[6 * 5..6 * 6];
+    t.swap(1, 2);
+    t.swap(3, 5);
+    let from_arrays = |flags: u32| {
+        let mut s = null_mut();
+        // SAFETY: arrays of the stated lengths.
+        let st = unsafe {
+            curvetet_surface_from_arrays_with_flags(
+                xyz.as_ptr(),
+                nodes.len() + 1,
+                tri6.as_ptr(),
+                tris.len(),
+                null(),
+                flags,
+                &mut s,
+            )
+        };
+        (st, s)
+    };
+    let (st, s) = from_arrays(0);
+    assert_eq!(st, curvetet_status::CURVETET_OK, "{}", last_error());
+    // SAFETY: a live surface.
+    unsafe {
+        assert_eq!(curvetet_surface_num_warnings(s), 2);
+        assert_eq!(curvetet_surface_num_nodes(s), nodes.len());
+        let w = CStr::from_ptr(curvetet_surface_warning(s, 1)).to_string_lossy();
+        assert!(w.contains("flipped 1 of"), "{w}");
+        let mut back = vec![0u32; 6 * tris.len()];
+        curvetet_surface_triangles(s, back.as_mut_ptr(), null_mut());
+        assert_eq!(back, tris.iter().flatten().copied().collect::<Vec<_>>());
+        curvetet_surface_free(s);
+    }
+    let (st, s) = from_arrays(CURVETET_SURFACE_STRICT);
+    assert_eq!(st, curvetet_status::CURVETET_ERR_INVALID_SURFACE);
+    assert!(s.is_null());
+    assert!(last_error().contains("unused-node"), "{}", last_error());
+    let (st, _) = from_arrays(2);
+    assert_eq!(st, curvetet_status::CURVETET_ERR_INVALID_ARGUMENT);
+    assert!(
+        last_error().contains("unknown flag bits 0x2"),
+        "{}",
+        last_error()
+    );
+
+    // Linear: the octahedron with one facet flipped.
+    let xyz: [f64; 18] = [
+        1.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0,
+    ];
+    let tri3: [u32; 24] = [
+        0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 5, 3,
+    ];
+    let linear = |flags: u32| {
+        let mut s = null_mut();
+        // SAFETY: arrays of the stated lengths.
+        let st = unsafe {
+            curvetet_surface_from_linear_with_flags(
+                xyz.as_ptr(),
+                6,
+                tri3.as_ptr(),
+                8,
+                null(),
+                40.0,
+                0,
+                flags,
+                &mut s,
+            )
+        };
+        // SAFETY: NULL or live.
+        unsafe { curvetet_surface_free(s) };
+        st
+    };
+    assert_eq!(linear(0), curvetet_status::CURVETET_OK, "{}", last_error());
+    assert_eq!(
+        linear(CURVETET_SURFACE_STRICT),
+        curvetet_status::CURVETET_ERR_INVALID_SURFACE
+    );
+    assert!(last_error().contains("inconsistent-orientation"));
+
+    // A file: the bad corpus's cavity facing out.
+    let p = CString::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/bad/shells_disagree.msh"
+    ))
+    .unwrap();
+    for (flags, want) in [
+        (0, curvetet_status::CURVETET_OK),
+        (
+            CURVETET_SURFACE_STRICT,
+            curvetet_status::CURVETET_ERR_INVALID_SURFACE,
+        ),
+    ] {
+        let mut s = null_mut();
+        // SAFETY: a NUL-terminated path.
+        let st = unsafe { curvetet_surface_read_with_flags(p.as_ptr(), flags, &mut s) };
+        assert_eq!(st, want, "{}", last_error());
+        // SAFETY: NULL or live.
+        unsafe { curvetet_surface_free(s) };
+    }
+}

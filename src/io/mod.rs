@@ -76,7 +76,10 @@ mod weld;
 
 pub use atomic::{check_output_dir, remove_unfinished_temporaries, same_file, write_atomic};
 pub use groups::{Groups, PhysicalName, DEFAULT_VOLUME_NAME, UNTAGGED_BOUNDARY_NAME};
-pub use surface::{read_any_surface, read_surface, surface_from_raw, surface_from_raw_any};
+pub use surface::{
+    read_any_surface, read_surface, surface_from_raw, surface_from_raw_any,
+    surface_from_raw_with_repair,
+};
 
 /// The physical (msh) and reference (medit) tag written for the tetrahedra.
 pub const VOLUME_TAG: i32 = 1;

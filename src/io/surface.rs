@@ -2,6 +2,7 @@
 
 use super::RawMesh;
 use crate::surface::curve::{curve_linear, CurveOptions};
+use crate::surface::Repair;
 use crate::{Error, Result, Surface, SurfaceDefect};
 use std::path::Path;
 
@@ -34,11 +35,17 @@ pub fn surface_from_raw_any(raw: RawMesh, name: &str, opts: &CurveOptions) -> Re
         let groups = raw.groups();
         return Ok(curve_linear(raw.nodes, raw.tri3, raw.tri3_tags, opts)?.with_groups(groups));
     }
-    surface_from_raw(raw, name)
+    surface_from_raw_with_repair(raw, name, opts.repair)
 }
 
 /// The P2 surface of a [`RawMesh`]; `name` is used in messages.
 pub fn surface_from_raw(raw: RawMesh, name: &str) -> Result<Surface> {
+    surface_from_raw_with_repair(raw, name, Repair::Unambiguous)
+}
+
+/// [`surface_from_raw`], with the unambiguous repairs allowed or refused (see
+/// [`crate::surface::repair`]).
+pub fn surface_from_raw_with_repair(raw: RawMesh, name: &str, repair: Repair) -> Result<Surface> {
     if raw.tri6.is_empty() {
         let msg = if raw.tri3.is_empty() {
             format!("{name}: no triangles found (a closed 6-node triangle surface is needed)")
@@ -76,5 +83,5 @@ pub fn surface_from_raw(raw: RawMesh, name: &str) -> Result<Surface> {
         }
         (nodes, tris)
     };
-    Ok(Surface::new(nodes, tris, raw.tri6_tags)?.with_groups(groups))
+    Ok(Surface::new_with_repair(nodes, tris, raw.tri6_tags, repair)?.with_groups(groups))
 }

@@ -12,18 +12,21 @@
 //! 2. [`coords`]: NaN/Inf ([`NonFiniteCoordinate`](SurfaceDefect::NonFiniteCoordinate));
 //!    the range the exact predicates need ([`CoordinateRange`](SurfaceDefect::CoordinateRange),
 //!    limits in [`coords::MAX_ABS_COORDINATE`] and friends).
-//! 3. Unused nodes ([`UnusedNode`](SurfaceDefect::UnusedNode)), then identical
-//!    coordinates ([`DuplicateNode`](SurfaceDefect::DuplicateNode), by sorting).
+//! 3. Unused nodes ([`UnusedNode`](SurfaceDefect::UnusedNode); dropped with a warning
+//!    before the coordinate checks unless [`Repair::Strict`], see [`repair`]), then
+//!    identical coordinates ([`DuplicateNode`](SurfaceDefect::DuplicateNode), by sorting).
 //! 4. [`topology`]: the corner-edge rule (see there) — non-manifold edges, open edges,
-//!    edges used twice in one direction, mid-node sharing; then one fan per vertex.
+//!    edges used twice in one direction (each shell made consistent with a warning unless
+//!    [`Repair::Strict`]), mid-node sharing; then one fan per vertex.
 //! 5. [`geometry`]: exactly collinear corners; a mid node more than an edge length from
 //!    its edge's midpoint ([`MidNodeMismatch`](SurfaceDefect::MidNodeMismatch)); folded
 //!    curved triangles (order-6 lattice).
 //! 6. [`intersect`]: exact self-intersection of the chord triangles, then of the four flat
 //!    sub-triangles of every curved triangle (both are errors; see there why).
 //! 7. [`orientation`]: per shell, the exact sign of the enclosed chord volume and the
-//!    nesting depth (exact ray parity); an all-inward surface is flipped with a warning,
-//!    a mixed one is an error.
+//!    nesting depth (exact ray parity); an all-inward surface is flipped with a warning;
+//!    in a mixed one the wrong shells are flipped with a warning (an error under
+//!    [`Repair::Strict`]).
 //!
 //! A *linear* surface (3-node triangles, from STL/OFF/OBJ/PLY) becomes a P2 surface
 //! through [`curve`] ([`Surface::from_linear`]): the same checks on its flat triangles,
@@ -40,6 +43,7 @@ pub mod indices;
 pub mod intersect;
 pub mod measure;
 pub mod orientation;
+pub mod repair;
 pub mod topology;
 
 #[cfg(test)]
@@ -47,11 +51,10 @@ mod tests;
 
 use std::collections::HashMap;
 
-#[cfg(doc)]
-use crate::error::SurfaceDefect;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::P3;
 
+pub use repair::Repair;
 pub use topology::SurfaceEdge;
 
 /// Surfaces where more than one triangle in this many is poorly shaped
@@ -96,8 +99,32 @@ impl Surface {
     /// `nodes` are coordinates; `tris` are 6-node triangles (0-based node indices, Gmsh
     /// order); `tags` gives one tag per triangle, or is empty (all tags 0). Runs every
     /// check listed in the [module docs](self) and returns the first failure; a
-    /// consistently inward surface is flipped (see [`FLIPPED_WARNING`]).
-    pub fn new(nodes: Vec<P3>, mut tris: Vec<[u32; 6]>, tags: Vec<i32>) -> Result<Surface> {
+    /// consistently inward surface is flipped (see [`FLIPPED_WARNING`]). Unused nodes are
+    /// dropped and inconsistently oriented shells reoriented, with a warning
+    /// ([`repair`]); [`Surface::new_with_repair`] with [`Repair::Strict`] refuses them.
+    pub fn new(nodes: Vec<P3>, tris: Vec<[u32; 6]>, tags: Vec<i32>) -> Result<Surface> {
+        Surface::new_with_repair(nodes, tris, tags, Repair::Unambiguous)
+    }
+
+    /// [`Surface::new`], with the unambiguous repairs ([`repair`]) allowed or refused.
+    pub fn new_with_repair(
+        nodes: Vec<P3>,
+        tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        repair: Repair,
+    ) -> Result<Surface> {
+        Surface::build(nodes, tris, tags, repair, repair::Done::default())
+    }
+
+    /// [`Surface::new_with_repair`] after repairs `done` earlier (by the linear checks),
+    /// so that one warning tells all.
+    pub(crate) fn build(
+        mut nodes: Vec<P3>,
+        mut tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        repair: Repair,
+        mut done: repair::Done,
+    ) -> Result<Surface> {
         let tags = if tags.is_empty() {
             vec![0; tris.len()]
         } else if tags.len() != tris.len() {
@@ -122,22 +149,97 @@ impl Surface {
             )));
         }
         indices::check_indices(nodes.len(), &tris)?;
+        if repair.allowed() {
+            if let Some((kept, renumbered, dropped)) = repair::drop_unused(&nodes, &tris) {
+                done.record_dropped(dropped, nodes.len(), "nodes");
+                (nodes, tris) = (kept, renumbered);
+            }
+        }
+        let dropped = done.dropped_note();
+        Surface::checked(nodes, tris, tags, repair, done).map_err(|e| dropped.explain(e))
+    }
+
+    /// The checks of [`Surface::build`] after the indices (and the dropping of unused
+    /// nodes).
+    fn checked(
+        nodes: Vec<P3>,
+        mut tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        repair: Repair,
+        mut done: repair::Done,
+    ) -> Result<Surface> {
         coords::check_coordinates(&nodes)?;
         indices::check_unused(nodes.len(), &tris, &nodes)?;
         coords::check_duplicates(&nodes)?;
-        let topo = topology::Topology::build(&nodes, &tris)?;
+        let topo = match topology::Topology::build(&nodes, &tris) {
+            // Every edge is used twice (open and non-manifold edges are reported first),
+            // some in the same direction: make each shell consistent, if it can be.
+            Err(e)
+                if repair.allowed()
+                    && e.surface_defect() == Some(SurfaceDefect::InconsistentOrientation) =>
+            {
+                let Some(flips) = repair::consistent_flips(&tris) else {
+                    return Err(e);
+                };
+                for (t, &f) in tris.iter_mut().zip(&flips) {
+                    if f {
+                        repair::flip(t);
+                    }
+                }
+                done.add_flips(&flips);
+                topology::Topology::build(&nodes, &tris)?
+            }
+            r => r?,
+        };
         geometry::check_degenerate(&nodes, &tris)?;
         geometry::check_mid_offsets(&nodes, &tris)?;
         geometry::check_folded(&nodes, &tris)?;
         intersect::check_intersections(&nodes, &tris)?;
         let mut warnings = Vec::new();
+        warnings.extend(done.dropped_warning());
         let mut neighbors = topo.neighbors;
         let mut edges = topo.edges;
-        if orientation::check_orientation(&nodes, &tris, &topo.shell, topo.shell_count)?
-            == orientation::Verdict::Inward
-        {
-            orientation::flip_all(&mut tris, &mut neighbors, &mut edges);
+        let n_shells = topo.shell_count;
+        let shell_flipped = match orientation::orient_shells(
+            &nodes,
+            &tris,
+            &topo.shell,
+            n_shells,
+            repair.allowed(),
+        )? {
+            orientation::Shells::Outward => vec![false; n_shells],
+            orientation::Shells::Inward => {
+                orientation::flip_all(&mut tris, &mut neighbors, &mut edges);
+                vec![true; n_shells]
+            }
+            orientation::Shells::Wrong(wrong) => {
+                orientation::flip_shells(
+                    &mut tris,
+                    &mut neighbors,
+                    &mut edges,
+                    &topo.shell,
+                    &wrong,
+                );
+                wrong
+            }
+        };
+        if done.flipped.is_empty() && shell_flipped.iter().all(|&f| f) {
             warnings.push(FLIPPED_WARNING.to_string());
+        } else if !done.flipped.is_empty() || shell_flipped.iter().any(|&f| f) {
+            // Net flips: the consistency walk's, undone or not by its shell's flip.
+            let mut per_shell = vec![0usize; n_shells];
+            for (t, &s) in topo.shell.iter().enumerate() {
+                let walked = done.flipped.get(t).copied().unwrap_or(false);
+                if walked != shell_flipped[s as usize] {
+                    per_shell[s as usize] += 1;
+                }
+            }
+            warnings.push(repair::reoriented_warning(
+                per_shell.iter().sum(),
+                tris.len(),
+                per_shell.iter().filter(|&&n| n > 0).count(),
+                n_shells,
+            ));
         }
         let shape = geometry::triangle_shape(&nodes, &tris);
         let (poor, worst) = (shape.poor, shape.worst);

@@ -1,8 +1,8 @@
 //! Orientation of each shell, nesting of shells, and flipping an inside-out surface.
 //!
 //! Runs after the intersection checks, so the chord shells are embedded, pairwise
-//! disjoint and (by the vertex rule) vertex-disjoint; within a shell the edge rule has
-//! already made the orientation consistent.
+//! disjoint and (by the vertex rule) vertex-disjoint; within a shell the edge rule (or
+//! the repair before it) has already made the orientation consistent.
 //!
 //! **Shell orientation**: the exact sign of the volume enclosed by the shell's chord
 //! triangles, sum of det[a, b, c] over them, computed exactly (no tolerance) with a
@@ -22,8 +22,10 @@
 //! faces into the cavity, i.e. opposite to its container; an island inside a cavity is
 //! outward again). If every shell is the other way round, the whole surface is inside
 //! out: it is accepted and flipped, with the warning
-//! [`FLIPPED_WARNING`](super::FLIPPED_WARNING). If only some are, the shells disagree
-//! → [`InconsistentOrientation`](SurfaceDefect::InconsistentOrientation), naming one
+//! [`FLIPPED_WARNING`](super::FLIPPED_WARNING). If only some are, the shells disagree:
+//! the wrong ones are flipped with a warning ([`repair`](super::repair)), or under
+//! [`Repair::Strict`](super::Repair::Strict) it is an
+//! [`InconsistentOrientation`](SurfaceDefect::InconsistentOrientation) error naming one
 //! shell of each kind.
 //!
 //! **Flip**: corners (c0, c1, c2) become (c0, c2, c1); the mid nodes follow their edges:
@@ -116,6 +118,36 @@ pub fn check_orientation(
     shell: &[u32],
     n_shells: usize,
 ) -> Result<Verdict> {
+    match orient_shells(nodes, tris, shell, n_shells, false)? {
+        Shells::Outward => Ok(Verdict::Outward),
+        Shells::Inward => Ok(Verdict::Inward),
+        // Not returned when the shells may not be repaired.
+        Shells::Wrong(_) => Err(Error::InvalidArgument(
+            "internal: shells to flip without repair".to_string(),
+        )),
+    }
+}
+
+/// What [`orient_shells`] concluded about an acceptable surface.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum Shells {
+    /// Oriented outward as given.
+    Outward,
+    /// Consistently inside out: flip every triangle.
+    Inward,
+    /// Per shell, whether it faces the wrong way (some do, some do not): flip those.
+    Wrong(Vec<bool>),
+}
+
+/// [`check_orientation`]; when the shells disagree, `repair` says which to flip
+/// ([`Shells::Wrong`]) rather than refusing the surface.
+pub(crate) fn orient_shells(
+    nodes: &[P3],
+    tris: &[[u32; 6]],
+    shell: &[u32],
+    n_shells: usize,
+    repair: bool,
+) -> Result<Shells> {
     // Triangles grouped by shell (counting sort), lowest triangle first in each group.
     let mut start = vec![0usize; n_shells + 1];
     for &s in shell {
@@ -158,10 +190,13 @@ pub fn check_orientation(
         .map(|s| sign[s] != if depth[s] % 2 == 0 { 1 } else { -1 })
         .collect();
     if wrong.iter().all(|w| !w) {
-        return Ok(Verdict::Outward);
+        return Ok(Shells::Outward);
     }
     if wrong.iter().all(|w| *w) {
-        return Ok(Verdict::Inward);
+        return Ok(Shells::Inward);
+    }
+    if repair {
+        return Ok(Shells::Wrong(wrong));
     }
     let describe_shell = |s: usize| {
         let t = first_tri(s);
@@ -252,5 +287,28 @@ pub(crate) fn flip_all(
     }
     for e in edges.iter_mut() {
         e.tris.swap(0, 1);
+    }
+}
+
+/// Flips the triangles of the shells marked in `wrong` (by shell id, `shell` per
+/// triangle), keeping the adjacency and edges in step (an edge lies in one shell).
+pub(crate) fn flip_shells(
+    tris: &mut [[u32; 6]],
+    neighbors: &mut [[u32; 3]],
+    edges: &mut [SurfaceEdge],
+    shell: &[u32],
+    wrong: &[bool],
+) {
+    for (t, tri) in tris.iter_mut().enumerate() {
+        if wrong[shell[t] as usize] {
+            super::repair::flip(tri);
+            let n = &mut neighbors[t];
+            *n = [n[2], n[1], n[0]];
+        }
+    }
+    for e in edges.iter_mut() {
+        if wrong[shell[e.tris[0] as usize] as usize] {
+            e.tris.swap(0, 1);
+        }
     }
 }

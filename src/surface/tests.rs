@@ -38,12 +38,31 @@ impl P2 {
         Surface::new(self.nodes.clone(), self.tris.clone(), vec![])
     }
 
+    fn check_strict(&self) -> Result<Surface> {
+        Surface::new_with_repair(
+            self.nodes.clone(),
+            self.tris.clone(),
+            vec![],
+            Repair::Strict,
+        )
+    }
+
+    /// The defect the strict checks report. Without `Strict`, only unused nodes and
+    /// orientation may be repaired: every other defect is still refused.
     fn defect(&self) -> (SurfaceDefect, String) {
-        match self.check() {
+        let (kind, msg) = match self.check_strict() {
             Err(Error::InvalidSurface { kind, msg }) => (kind, msg),
             Err(e) => panic!("expected a surface defect, got {e}"),
             Ok(_) => panic!("expected a surface defect, the surface was accepted"),
+        };
+        if !matches!(
+            kind,
+            SurfaceDefect::UnusedNode | SurfaceDefect::InconsistentOrientation
+        ) {
+            let e = self.check().expect_err("refused without --strict too");
+            assert_eq!(e.surface_defect(), Some(kind), "{e}");
         }
+        (kind, msg)
     }
 
     /// Another surface's triangles added as a separate set of nodes.
@@ -801,6 +820,219 @@ fn separate_bodies() {
     // Both inward: flipped as a whole.
     let surf = a.flipped().union(&b.flipped()).check().unwrap();
     assert_eq!(surf.warnings().len(), 1);
+}
+
+// ---------------------------------------------------------------- repairs
+
+/// The reorientation warning says how many triangles of how many shells were flipped.
+fn assert_reoriented(surf: &Surface, flipped: usize, shells: usize) {
+    let w = surf.warnings();
+    assert_eq!(w.len(), 1, "{w:?}");
+    let want = format!(
+        "flipped {flipped} of {} triangles in {shells} of {} shell(s)",
+        surf.triangles().len(),
+        surf.shell_count()
+    );
+    assert!(w[0].contains(&want), "{w:?} lacks {want:?}");
+}
+
+#[test]
+fn one_flipped_triangle_is_reoriented() {
+    let orig = octahedron(1.0);
+    let mut s = orig.clone();
+    let t = s.tris[6];
+    s.tris[6] = [t[0], t[2], t[1], t[5], t[4], t[3]];
+    let surf = s.check().unwrap();
+    assert_eq!(surf.triangles(), &orig.tris[..]);
+    assert_reoriented(&surf, 1, 1);
+    // The same when the flipped triangle is the shell's first: the other 7 agree with
+    // it at first, then the shell is found inward and flipped back as a whole.
+    let mut s = orig.clone();
+    let t = s.tris[0];
+    s.tris[0] = [t[0], t[2], t[1], t[5], t[4], t[3]];
+    let surf = s.check().unwrap();
+    assert_eq!(surf.triangles(), &orig.tris[..]);
+    assert_reoriented(&surf, 1, 1);
+    let ref_s = orig.check().unwrap();
+    assert_eq!(surf.neighbors(), ref_s.neighbors());
+    assert_eq!(surf.edges(), ref_s.edges());
+}
+
+#[test]
+fn random_flips_of_p2_triangles_are_undone() {
+    use rand::{Rng, SeedableRng};
+    let orig = icosahedron();
+    let clean = orig.check().unwrap();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(28);
+    for _ in 0..20 {
+        let mut s = orig.clone();
+        let mut n = 0;
+        for t in &mut s.tris {
+            if rng.random_range(0..3) == 0 {
+                *t = [t[0], t[2], t[1], t[5], t[4], t[3]];
+                n += 1;
+            }
+        }
+        if n == 0 || n == s.tris.len() {
+            continue;
+        }
+        let surf = s.check().unwrap();
+        assert_eq!(surf.triangles(), &orig.tris[..]);
+        assert_eq!(surf.edges(), clean.edges());
+        assert_reoriented(&surf, n, 1);
+        let (kind, msg) = s.defect();
+        assert_eq!(kind, SurfaceDefect::InconsistentOrientation, "{msg}");
+        assert!(msg.contains("same direction"), "{msg}");
+    }
+}
+
+#[test]
+fn cavity_facing_the_wrong_way_is_flipped() {
+    let (outer, inner) = (octahedron(2.0), octahedron(1.0));
+    let good = outer.union(&inner.flipped());
+    let surf = outer.union(&inner).check().unwrap();
+    assert_eq!(surf.triangles(), &good.tris[..]);
+    assert_reoriented(&surf, 8, 1);
+    let v = surf.chord_volume();
+    assert!((v - (32.0 / 3.0 - 4.0 / 3.0)).abs() < 1e-12, "{v}");
+    // Outer inward, cavity right (facing into the cavity, like an inward outer shell):
+    // the outer one is flipped.
+    let surf = outer.flipped().union(&inner.flipped()).check().unwrap();
+    assert_eq!(surf.triangles(), &good.tris[..]);
+    assert_reoriented(&surf, 8, 1);
+    // One triangle of the cavity flipped as well: 7 of its 8 need flipping.
+    let mut s = outer.union(&inner);
+    let t = s.tris[9];
+    s.tris[9] = [t[0], t[2], t[1], t[5], t[4], t[3]];
+    let surf = s.check().unwrap();
+    assert_eq!(surf.triangles(), &good.tris[..]);
+    assert_reoriented(&surf, 7, 1);
+    // An island in the cavity facing in: flipped outward.
+    let island = octahedron(0.5);
+    let surf = good.union(&island.flipped()).check().unwrap();
+    assert_eq!(surf.triangles(), &good.union(&island).tris[..]);
+    assert_reoriented(&surf, 8, 1);
+}
+
+#[test]
+fn a_separate_body_facing_in_is_flipped() {
+    let a = icosahedron();
+    let b = icosahedron().moved(|p| add(p, [5.0, 0.5, 0.25]));
+    let surf = a.union(&b.flipped()).check().unwrap();
+    assert_eq!(surf.triangles(), &a.union(&b).tris[..]);
+    assert_reoriented(&surf, 20, 1);
+}
+
+#[test]
+fn unused_nodes_are_dropped() {
+    let orig = octahedron(1.0);
+    let mut s = orig.clone();
+    // One unused node at the end, one at the front (all indices shift by one).
+    s.nodes.push([5.0, 5.0, 5.0]);
+    s.nodes.insert(0, [7.0, 0.0, 0.0]);
+    for t in &mut s.tris {
+        *t = t.map(|v| v + 1);
+    }
+    let surf = s.check().unwrap();
+    assert_eq!(surf.nodes(), &orig.nodes[..]);
+    assert_eq!(surf.triangles(), &orig.tris[..]);
+    assert_eq!(
+        surf.warnings(),
+        &[
+            "2 of 20 nodes used by no triangle: dropped, the others renumbered (`--strict` \
+           refuses this)"
+                .to_string()
+        ]
+    );
+    // Strict: the old error, naming the first unused node.
+    let (kind, msg) = s.defect();
+    assert_eq!(kind, SurfaceDefect::UnusedNode);
+    assert!(
+        msg.contains("node 0 (7.0, 0.0, 0.0)") && msg.contains("2 unused"),
+        "{msg}"
+    );
+    // An unused node's coordinates do not matter: dropped before they are checked.
+    let mut nan = s.clone();
+    nan.nodes[0] = [f64::NAN; 3];
+    assert_eq!(nan.check().unwrap().nodes(), &orig.nodes[..]);
+    // Both repairs at once: two warnings.
+    let t = s.tris[3];
+    s.tris[3] = [t[0], t[2], t[1], t[5], t[4], t[3]];
+    let surf = s.check().unwrap();
+    assert_eq!(surf.triangles(), &orig.tris[..]);
+    assert_eq!(surf.warnings().len(), 2, "{:?}", surf.warnings());
+    assert!(surf.warnings()[1].contains("flipped 1 of 8"));
+}
+
+#[test]
+fn a_non_orientable_surface_stays_an_error() {
+    // The 6-vertex projective plane (on vertices in general position): every edge used
+    // twice, no consistent orientation. Refused as before, repair or not.
+    let v = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.1, 0.2],
+        [0.3, 1.0, 0.1],
+        [0.2, 0.4, 1.0],
+        [1.1, 1.2, 0.3],
+        [0.5, -0.7, 0.9],
+    ];
+    let s = P2::new(&v, &super::repair::tests::RP2, mid);
+    let (kind, msg) = s.defect();
+    assert_eq!(kind, SurfaceDefect::InconsistentOrientation, "{msg}");
+    let e = s.check().expect_err("refused");
+    assert_eq!(
+        e.surface_defect(),
+        Some(SurfaceDefect::InconsistentOrientation)
+    );
+    assert!(e.to_string().contains("same direction"), "{e}");
+}
+
+#[test]
+fn errors_after_dropping_unused_nodes_say_the_numbers_changed() {
+    let mut s = octahedron(1.0);
+    s.nodes.insert(0, [7.0, 0.0, 0.0]);
+    for t in &mut s.tris {
+        *t = t.map(|v| v + 1);
+    }
+    s.tris.remove(3);
+    let e = s.check().expect_err("open");
+    assert_eq!(e.surface_defect(), Some(SurfaceDefect::NotClosed));
+    let note = " (nodes numbered after dropping the 1 that no triangle uses; `--strict` keeps \
+                the input's numbers)";
+    assert!(e.to_string().ends_with(note), "{e}");
+    assert_eq!(e.to_string().matches("numbered after").count(), 1, "{e}");
+    // Strict: the unused node first, in the input's numbers.
+    assert_eq!(s.defect().0, SurfaceDefect::UnusedNode);
+    // Linear: the same, once.
+    let tri3: Vec<[u32; 3]> = s.tris.iter().map(|t| [t[0], t[1], t[2]]).collect();
+    let nodes = s.nodes.clone();
+    let e = Surface::from_linear(nodes, tri3, vec![], 40.0).expect_err("open");
+    assert_eq!(e.surface_defect(), Some(SurfaceDefect::NotClosed));
+    assert!(
+        e.to_string()
+            .contains("vertices numbered after dropping the"),
+        "{e}"
+    );
+    assert_eq!(e.to_string().matches("numbered after").count(), 1, "{e}");
+}
+
+#[test]
+fn clean_surfaces_are_not_touched() {
+    // Nothing to repair: the very triangles, no warning (strict or not).
+    for s in [octahedron(1.0), icosahedron(), cube()] {
+        let a = s.check().unwrap();
+        let b = s.check_strict().unwrap();
+        assert_eq!(a.triangles(), &s.tris[..]);
+        assert_eq!(a.nodes(), &s.nodes[..]);
+        assert_eq!(a.triangles(), b.triangles());
+        assert!(a.warnings().is_empty() && b.warnings().is_empty());
+    }
+    // Inside out: flipped with the same warning as ever, strict or not.
+    let s = icosahedron().flipped();
+    for surf in [s.check().unwrap(), s.check_strict().unwrap()] {
+        assert_eq!(surf.warnings(), &[FLIPPED_WARNING.to_string()]);
+        assert_eq!(surf.triangles(), &icosahedron().tris[..]);
+    }
 }
 
 #[test]

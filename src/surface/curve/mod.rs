@@ -31,7 +31,10 @@
 //!    sends the surface back to the guards).
 //!
 //! Input vertices keep their index and their bit-exact coordinates; mid nodes follow them,
-//! one per edge in sorted (smaller vertex, larger vertex) order.
+//! one per edge in sorted (smaller vertex, larger vertex) order. Unless
+//! [`CurveOptions::repair`] is [`Repair::Strict`], vertices no triangle uses are dropped
+//! first (the others keep their order) and inconsistently oriented facets are flipped,
+//! each with a warning (see [`crate::surface::repair`]).
 //!
 //! **Why the arc rule** (measured on the benchmark surfaces, `tests/curve.rs`, Max
 //! normals): on the sphere (h = 0.2) the arc rule puts every mid node on the sphere (max
@@ -52,7 +55,8 @@ pub use guard::GuardCounts;
 use crate::error::{Error, Result, SurfaceDefect};
 use crate::geom::vec3::{dot, normalize, scale, sub};
 use crate::geom::P3;
-use crate::surface::Surface;
+use crate::surface::repair::{self, Done};
+use crate::surface::{Repair, Surface};
 
 use midpoint::{arc_mid, pn_mid, tangent_from_normal};
 
@@ -111,6 +115,11 @@ pub struct CurveOptions {
     /// segmentation, whose needle and cap triangles leave the front stuck; moves the
     /// surface.
     pub smooth_iterations: u32,
+    /// Whether unused vertices are dropped and inconsistently oriented shells reoriented
+    /// (with a warning), or refused ([`Repair::Strict`]). Applies to P2 input read with
+    /// these options too ([`crate::io::read_any_surface`]). Default
+    /// [`Repair::Unambiguous`].
+    pub repair: Repair,
 }
 
 /// The most smoothing iterations [`CurveOptions::smooth_iterations`] accepts: each one
@@ -126,6 +135,7 @@ impl Default for CurveOptions {
             rule: MidpointRule::Arc,
             normals: NormalWeights::Max,
             smooth_iterations: 0,
+            repair: Repair::Unambiguous,
         }
     }
 }
@@ -213,6 +223,26 @@ pub fn curve_linear_report(
             tri3.len()
         )));
     }
+    let (mut nodes, mut tri3) = (nodes, tri3);
+    let mut done = Done::default();
+    if opts.repair.allowed() {
+        if let Some((kept, renumbered, n)) = repair::drop_unused(&nodes, &tri3) {
+            done.record_dropped(n, nodes.len(), "vertices");
+            (nodes, tri3) = (kept, renumbered);
+        }
+    }
+    let dropped = done.dropped_note();
+    curve_checked(nodes, tri3, tags, opts, done).map_err(|e| dropped.explain(e))
+}
+
+/// [`curve_linear_report`] after the unused vertices were dropped (`done`).
+fn curve_checked(
+    nodes: Vec<P3>,
+    mut tri3: Vec<[u32; 3]>,
+    tags: Vec<i32>,
+    opts: &CurveOptions,
+    mut done: Done,
+) -> Result<(Surface, CurveReport)> {
     let nodes = if opts.smooth_iterations > 0 {
         // Smooth the checked surface, then check the smoothed one (it must still be a
         // valid surface: no fold, no self-intersection).
@@ -221,14 +251,14 @@ pub fn curve_linear_report(
             edges,
             n_input,
             ..
-        } = check::check_linear(nodes, &tri3)?;
+        } = check_repaired(nodes, &mut tri3, opts.repair, &mut done)?;
         smooth::taubin(&mut nodes, n_input, &edges, opts.smooth_iterations);
         nodes.truncate(n_input);
         nodes
     } else {
         nodes
     };
-    let lifted = check::check_linear(nodes, &tri3)?;
+    let lifted = check_repaired(nodes, &mut tri3, opts.repair, &mut done)?;
     let check::Lifted {
         mut nodes,
         tris,
@@ -327,7 +357,13 @@ pub fn curve_linear_report(
             n_input,
         };
         report.straightened.fold += guard::fold_guard(&mut state, opts.min_normal_cosine);
-        match Surface::new(state.nodes.to_vec(), tris.clone(), tags.clone()) {
+        match Surface::build(
+            state.nodes.to_vec(),
+            tris.clone(),
+            tags.clone(),
+            opts.repair,
+            done.clone(),
+        ) {
             Ok(s) => break s,
             Err(e)
                 if matches!(
@@ -353,6 +389,36 @@ pub fn curve_linear_report(
     Ok((surface, report))
 }
 
+/// [`check::check_linear`]; when `repair` allows and the triangles are not consistently
+/// oriented (on a closed manifold surface), each shell is made consistent (recorded in
+/// `done`) and the checks run again.
+fn check_repaired(
+    nodes: Vec<P3>,
+    tri3: &mut [[u32; 3]],
+    repair: Repair,
+    done: &mut Done,
+) -> Result<check::Lifted> {
+    if !repair.allowed() {
+        return check::check_linear(nodes, tri3);
+    }
+    let again = nodes.clone();
+    match check::check_linear(nodes, tri3) {
+        Err(e) if e.surface_defect() == Some(SurfaceDefect::InconsistentOrientation) => {
+            let Some(flips) = repair::consistent_flips(tri3) else {
+                return Err(e);
+            };
+            for (t, &f) in tri3.iter_mut().zip(&flips) {
+                if f {
+                    repair::flip(t);
+                }
+            }
+            done.add_flips(&flips);
+            check::check_linear(again, tri3)
+        }
+        r => r,
+    }
+}
+
 /// `m` moved into the plane of triangle `tri` (unit normal `n`): exactly, by setting the
 /// shared coordinate, when the triangle's corners share one (an axis-aligned plane);
 /// otherwise by projection (to rounding).
@@ -374,7 +440,8 @@ impl Surface {
     /// feature angle `feature_angle_deg` (degrees; 40 is the usual choice): see
     /// [`curve_linear`]. This is the entry point for callers that hold a linear mesh in
     /// memory (the C ABI, VTK polydata, MeshLab layers). Input vertices keep their index
-    /// and exact coordinates; one mid node per edge is appended after them.
+    /// and exact coordinates (unused ones are dropped, with a warning); one mid node per
+    /// edge is appended after them.
     pub fn from_linear(
         nodes: Vec<P3>,
         tri3: Vec<[u32; 3]>,
