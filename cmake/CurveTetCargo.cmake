@@ -4,7 +4,8 @@
 # Both carry the include directory of curvetet.h. The library files are copied from cargo's
 # target directory into <build>/lib (the shared one under its SONAME, plus the
 # libcurvetet.so link), which is also what gets installed, and the command-line tool into
-# <build>/bin/curvetet (CURVETET_EXECUTABLE, installed into <prefix>/bin).
+# <build>/bin/curvetet (CURVETET_EXECUTABLE, installed into <prefix>/bin; the option
+# CURVETET_BUILD_CLI=OFF leaves it out).
 
 if(NOT CMAKE_SYSTEM_NAME STREQUAL "Linux")
   message(FATAL_ERROR "curvetet's CMake build supports Linux only for now (library names, SONAME, system libraries)")
@@ -64,7 +65,14 @@ if(NOT DEFINED CACHE{CURVETET_NATIVE_STATIC_LIBS})
 endif()
 message(STATUS "curvetet: static library needs: ${CURVETET_NATIVE_STATIC_LIBS}")
 
-set(_cargo_out "${CURVETET_CARGO_TARGET_DIR}/release")
+# The command-line tool needs the cargo feature `cli` (on by default: its argument parser
+# and progress bar); the C library is built without it (--no-default-features), so that it
+# compiles none of the tool's crates. The two builds use two target directories: cargo
+# keeps one copy of a package's cdylib/staticlib per target directory, and building the
+# library with and without the feature (the tool's build and `cargo test` build it with)
+# in one directory would compile it again at every switch.
+set(_cargo_lib_target_dir "${CURVETET_CARGO_TARGET_DIR}/no-default-features")
+set(_cargo_out "${_cargo_lib_target_dir}/release")
 set(CURVETET_LIBRARY_DIR "${CMAKE_BINARY_DIR}/lib")
 set(CURVETET_STATIC_LIBRARY "${CURVETET_LIBRARY_DIR}/libcurvetet.a")
 set(CURVETET_SHARED_LIBRARY "${CURVETET_LIBRARY_DIR}/${CURVETET_SONAME}")
@@ -72,20 +80,34 @@ set(CURVETET_SHARED_LINK "${CURVETET_LIBRARY_DIR}/libcurvetet.so")
 set(CURVETET_EXECUTABLE "${CMAKE_BINARY_DIR}/bin/curvetet")
 file(MAKE_DIRECTORY "${CURVETET_LIBRARY_DIR}" "${CMAKE_BINARY_DIR}/bin")
 
+option(CURVETET_BUILD_CLI "Build and install the command-line tool (bin/curvetet)" ON)
+
+set(_cargo_build "${CARGO_EXECUTABLE}" build --release --quiet
+                 --manifest-path "${PROJECT_SOURCE_DIR}/Cargo.toml")
+set(_cli_commands "")
+set(_cli_byproducts "")
+if(CURVETET_BUILD_CLI)
+  set(_cli_commands
+    COMMAND "${CMAKE_COMMAND}" -E env "CARGO_TARGET_DIR=${CURVETET_CARGO_TARGET_DIR}"
+            ${_cargo_build} --bin curvetet
+    COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${CURVETET_CARGO_TARGET_DIR}/release/curvetet"
+            "${CURVETET_EXECUTABLE}")
+  set(_cli_byproducts "${CURVETET_EXECUTABLE}")
+endif()
+
 # Always ask cargo (it knows the Rust dependencies exactly and does nothing when the
 # library is up to date); copy only when the files changed, so C targets relink only then.
 add_custom_target(curvetet_cargo ALL
-  COMMAND "${CMAKE_COMMAND}" -E env "CARGO_TARGET_DIR=${CURVETET_CARGO_TARGET_DIR}"
-          "${CARGO_EXECUTABLE}" build --release --lib --bin curvetet --quiet
-          --manifest-path "${PROJECT_SOURCE_DIR}/Cargo.toml"
+  COMMAND "${CMAKE_COMMAND}" -E env "CARGO_TARGET_DIR=${_cargo_lib_target_dir}"
+          ${_cargo_build} --lib --no-default-features
   COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${_cargo_out}/libcurvetet.a" "${CURVETET_STATIC_LIBRARY}"
   COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${_cargo_out}/libcurvetet.so" "${CURVETET_SHARED_LIBRARY}"
   COMMAND "${CMAKE_COMMAND}" -E create_symlink "${CURVETET_SONAME}" "${CURVETET_SHARED_LINK}"
-  COMMAND "${CMAKE_COMMAND}" -E copy_if_different "${_cargo_out}/curvetet" "${CURVETET_EXECUTABLE}"
+  ${_cli_commands}
   BYPRODUCTS "${CURVETET_STATIC_LIBRARY}" "${CURVETET_SHARED_LIBRARY}" "${CURVETET_SHARED_LINK}"
-             "${CURVETET_EXECUTABLE}"
+             ${_cli_byproducts}
   WORKING_DIRECTORY "${PROJECT_SOURCE_DIR}"
-  COMMENT "cargo build --release --lib --bin curvetet (curvetet)"
+  COMMENT "cargo build --release (curvetet: the library without default features, the tool)"
   USES_TERMINAL
   VERBATIM)
 

@@ -1,6 +1,6 @@
 # Install layout (relative to the prefix; libdir is GNUInstallDirs' CMAKE_INSTALL_LIBDIR,
 # "lib" for prefixes other than /usr):
-#   bin/curvetet               (the command-line tool)
+#   bin/curvetet               (the command-line tool, unless CURVETET_BUILD_CLI is OFF)
 #   lib/libcurvetet.a
 #   lib/libcurvetet.so.<abi>   (the shared library, under its SONAME)
 #   lib/libcurvetet.so         -> libcurvetet.so.<abi>
@@ -11,7 +11,9 @@ include(CMakePackageConfigHelpers)
 
 set(CURVETET_CMAKE_DIR "${CMAKE_INSTALL_LIBDIR}/cmake/CurveTet")
 
-install(PROGRAMS "${CURVETET_EXECUTABLE}" DESTINATION "${CMAKE_INSTALL_BINDIR}")
+if(CURVETET_BUILD_CLI)
+  install(PROGRAMS "${CURVETET_EXECUTABLE}" DESTINATION "${CMAKE_INSTALL_BINDIR}")
+endif()
 install(FILES "${CURVETET_STATIC_LIBRARY}" DESTINATION "${CMAKE_INSTALL_LIBDIR}")
 install(FILES "${CURVETET_SHARED_LIBRARY}" DESTINATION "${CMAKE_INSTALL_LIBDIR}"
         PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE

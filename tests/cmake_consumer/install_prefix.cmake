@@ -1,6 +1,6 @@
 # ctest fixture: install the build tree into a fresh PREFIX and check the layout.
 #   cmake -DBUILD_DIR=... -DPREFIX=... -DLIBDIR=lib -DSONAME=libcurvetet.so.X -DBINDIR=bin
-#         -DVERSION=X.Y.Z [-DVTK=ON] [-DMESHLAB=ON]
+#         -DVERSION=X.Y.Z -DCLI=ON|OFF [-DVTK=ON] [-DMESHLAB=ON]
 #         -P install_prefix.cmake
 file(REMOVE_RECURSE "${PREFIX}")
 execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${PREFIX}"
@@ -29,12 +29,16 @@ foreach(f ${_vtk_files}
     message(FATAL_ERROR "install lacks ${f}")
   endif()
 endforeach()
-# The command-line tool, installed and runnable.
-execute_process(COMMAND "${PREFIX}/${BINDIR}/curvetet" --version
-                OUTPUT_VARIABLE _cli_version RESULT_VARIABLE _cli_rc)
-if(NOT _cli_rc EQUAL 0 OR NOT _cli_version MATCHES "curvetet ${VERSION}")
-  message(FATAL_ERROR "${BINDIR}/curvetet --version: exit ${_cli_rc}, '${_cli_version}' "
-                      "(expected curvetet ${VERSION})")
+# The command-line tool, installed and runnable (unless CURVETET_BUILD_CLI is OFF).
+if(CLI)
+  execute_process(COMMAND "${PREFIX}/${BINDIR}/curvetet" --version
+                  OUTPUT_VARIABLE _cli_version RESULT_VARIABLE _cli_rc)
+  if(NOT _cli_rc EQUAL 0 OR NOT _cli_version MATCHES "curvetet ${VERSION}")
+    message(FATAL_ERROR "${BINDIR}/curvetet --version: exit ${_cli_rc}, '${_cli_version}' "
+                        "(expected curvetet ${VERSION})")
+  endif()
+elseif(EXISTS "${PREFIX}/${BINDIR}/curvetet")
+  message(FATAL_ERROR "${BINDIR}/curvetet is installed although CURVETET_BUILD_CLI is OFF")
 endif()
 if(NOT IS_SYMLINK "${PREFIX}/${LIBDIR}/libcurvetet.so")
   message(FATAL_ERROR "${LIBDIR}/libcurvetet.so should be a symlink to ${SONAME}")
