@@ -1,7 +1,7 @@
 # Install layout (relative to the prefix; libdir is GNUInstallDirs' CMAKE_INSTALL_LIBDIR,
 # "lib" for prefixes other than /usr):
 #   bin/curvetet               (the command-line tool, unless CURVETET_BUILD_CLI is OFF)
-#   lib/libcurvetet.a
+#   lib/libcurvetet.a          (libraries and tool without debug info: strip --strip-debug)
 #   lib/libcurvetet.so.<abi>   (the shared library, under its SONAME)
 #   lib/libcurvetet.so         -> libcurvetet.so.<abi>
 #   include/curvetet.h
@@ -20,6 +20,27 @@ install(FILES "${CURVETET_SHARED_LIBRARY}" DESTINATION "${CMAKE_INSTALL_LIBDIR}"
                     WORLD_READ WORLD_EXECUTE)
 install(FILES "${CURVETET_SHARED_LINK}" DESTINATION "${CMAKE_INSTALL_LIBDIR}") # a symlink
 install(FILES "${PROJECT_SOURCE_DIR}/include/curvetet.h" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
+
+# The installed libraries and tool carry no debug info: cargo's release profile keeps line
+# tables (debug = 1) for profilers and backtraces in the build tree, which makes the
+# libraries several times larger than their code. `strip --strip-debug` keeps the symbol
+# table (and so the exported C functions and readable profiles).
+if(NOT CMAKE_STRIP)
+  message(FATAL_ERROR "no strip program found (binutils): the installed libraries must be stripped")
+endif()
+set(_strip_files "${CMAKE_INSTALL_LIBDIR}/libcurvetet.a" "${CMAKE_INSTALL_LIBDIR}/${CURVETET_SONAME}")
+if(CURVETET_BUILD_CLI)
+  list(APPEND _strip_files "${CMAKE_INSTALL_BINDIR}/curvetet")
+endif()
+foreach(_f IN LISTS _strip_files)
+  install(CODE "
+    set(_file \"${_f}\")
+    if(NOT IS_ABSOLUTE \"\${_file}\")
+      set(_file \"\${CMAKE_INSTALL_PREFIX}/\${_file}\")
+    endif()
+    execute_process(COMMAND \"${CMAKE_STRIP}\" --strip-debug \"\$ENV{DESTDIR}\${_file}\"
+                    COMMAND_ERROR_IS_FATAL ANY)")
+endforeach()
 
 configure_package_config_file(
   "${PROJECT_SOURCE_DIR}/cmake/CurveTetConfig.cmake.in"

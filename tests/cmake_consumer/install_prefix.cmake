@@ -1,6 +1,6 @@
 # ctest fixture: install the build tree into a fresh PREFIX and check the layout.
 #   cmake -DBUILD_DIR=... -DPREFIX=... -DLIBDIR=lib -DSONAME=libcurvetet.so.X -DBINDIR=bin
-#         -DVERSION=X.Y.Z -DCLI=ON|OFF [-DVTK=ON] [-DMESHLAB=ON]
+#         -DVERSION=X.Y.Z -DCLI=ON|OFF -DREADELF=/usr/bin/readelf [-DVTK=ON] [-DMESHLAB=ON]
 #         -P install_prefix.cmake
 file(REMOVE_RECURSE "${PREFIX}")
 execute_process(COMMAND "${CMAKE_COMMAND}" --install "${BUILD_DIR}" --prefix "${PREFIX}"
@@ -30,6 +30,7 @@ foreach(f ${_vtk_files}
   endif()
 endforeach()
 # The command-line tool, installed and runnable (unless CURVETET_BUILD_CLI is OFF).
+set(_stripped "${LIBDIR}/libcurvetet.a" "${LIBDIR}/${SONAME}")
 if(CLI)
   execute_process(COMMAND "${PREFIX}/${BINDIR}/curvetet" --version
                   OUTPUT_VARIABLE _cli_version RESULT_VARIABLE _cli_rc)
@@ -37,8 +38,28 @@ if(CLI)
     message(FATAL_ERROR "${BINDIR}/curvetet --version: exit ${_cli_rc}, '${_cli_version}' "
                         "(expected curvetet ${VERSION})")
   endif()
+  list(APPEND _stripped "${BINDIR}/curvetet")
 elseif(EXISTS "${PREFIX}/${BINDIR}/curvetet")
   message(FATAL_ERROR "${BINDIR}/curvetet is installed although CURVETET_BUILD_CLI is OFF")
+endif()
+# Installed without debug info (cmake/CurveTetInstall.cmake strips it).
+if(NOT READELF)
+  message(FATAL_ERROR "install_prefix.cmake needs READELF (binutils' readelf)")
+endif()
+foreach(f IN LISTS _stripped)
+  execute_process(COMMAND "${READELF}" --section-headers --wide "${PREFIX}/${f}"
+                  OUTPUT_VARIABLE _sections RESULT_VARIABLE _rc)
+  if(NOT _rc EQUAL 0 OR NOT _sections MATCHES "\\.text")
+    message(FATAL_ERROR "readelf cannot read ${f} (exit ${_rc})")
+  endif()
+  if(_sections MATCHES "\\] +\\.debug_(info|line) ") # DWARF (not .debug_gdb_scripts)
+    message(FATAL_ERROR "${f} is installed with debug info (it should be stripped)")
+  endif()
+endforeach()
+# The shared library a host process loads stays small.
+file(SIZE "${PREFIX}/${LIBDIR}/${SONAME}" _so_size)
+if(_so_size GREATER_EQUAL 5000000)
+  message(FATAL_ERROR "${LIBDIR}/${SONAME} is ${_so_size} bytes installed (budget: under 5 MB)")
 endif()
 if(NOT IS_SYMLINK "${PREFIX}/${LIBDIR}/libcurvetet.so")
   message(FATAL_ERROR "${LIBDIR}/libcurvetet.so should be a symlink to ${SONAME}")
