@@ -6,6 +6,7 @@ use crate::mesh::TetMesh;
 /// What is wrong with an input surface. Tests and bindings match on this kind; the
 /// message in [`Error::InvalidSurface`] says where.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum SurfaceDefect {
     /// No triangles at all.
     Empty,
@@ -69,8 +70,10 @@ impl SurfaceDefect {
     }
 }
 
-/// Every way a curvetet call can fail.
+/// Every way a curvetet call can fail. New kinds may be added (`#[non_exhaustive]`): a
+/// `match` needs a `_` arm.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// A caller passed a bad option or argument (alpha <= 0, NaN size, NULL pointer...).
     #[error("invalid argument: {0}")]

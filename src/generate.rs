@@ -19,6 +19,7 @@ use std::time::Instant;
 
 /// Wall-clock seconds of each stage.
 #[derive(Debug, Clone, Default, serde::Serialize)]
+#[non_exhaustive]
 pub struct StageTimes {
     /// Size field set-up.
     pub size_field: f64,
@@ -36,6 +37,7 @@ pub struct StageTimes {
 
 /// A generated mesh with its report.
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Generated {
     /// The certified P2 mesh.
     pub mesh: TetMesh,

@@ -1,28 +1,79 @@
 //! curvetet: direct quadratic (10-node) curvilinear tetrahedral meshing of closed quadratic
 //! (6-node) triangle surfaces by an advancing front, with certified element validity.
 //!
-//! Data flows one way: [`io`] reads a [`Surface`] (checked on construction), the front
-//! fills it with straight-sided P2 tetrahedra, the optimizer moves the free high-order
-//! nodes, and the result is certified (Bernstein bounds of the Jacobian) before it is
-//! returned as a [`TetMesh`].
+//! Data flows one way: a reader ([`read_any_surface`], or [`Surface::new`] on arrays)
+//! gives a [`Surface`] (checked on construction), [`generate`] fills it with straight-sided
+//! P2 tetrahedra by an advancing front, moves the free high-order nodes to improve the
+//! elements, certifies every element (Bernstein bounds of the Jacobian) and returns the
+//! [`TetMesh`] with its [`QualityReport`]; a writer ([`write_mesh`]) saves it.
+//!
+//! ```
+//! use curvetet::{generate, Options, Surface};
+//!
+//! // A closed surface from arrays: the unit corner tetrahedron, four 6-node triangles
+//! // (corners, then the mid nodes of edges (0,1), (1,2), (2,0); outward).
+//! let nodes = vec![
+//!     [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0],
+//!     [0.5, 0.0, 0.0], [0.5, 0.5, 0.0], [0.0, 0.5, 0.0], // mid 01, 12, 02
+//!     [0.0, 0.0, 0.5], [0.5, 0.0, 0.5], [0.0, 0.5, 0.5], // mid 03, 13, 23
+//! ];
+//! let triangles = vec![
+//!     [0, 2, 1, 6, 5, 4],
+//!     [0, 1, 3, 4, 8, 7],
+//!     [0, 3, 2, 7, 9, 6],
+//!     [1, 2, 3, 5, 9, 8],
+//! ];
+//! let surface = Surface::new(nodes, triangles, Vec::new())?;
+//! let out = generate(&surface, &Options::default().with_threads(1))?;
+//! assert_eq!(out.report.num_invalid, 0); // every element certified
+//! assert!((out.report.volume_curved - 1.0 / 6.0).abs() < 1e-12);
+//! # Ok::<(), curvetet::Error>(())
+//! ```
+//!
+//! The command-line tool (`curvetet`, cargo feature `cli`, on by default) and the C ABI
+//! (`include/curvetet.h`) are built on the same functions.
 
-pub mod capi;
-pub mod error;
-pub mod front;
-pub mod generate;
-pub mod geom;
 pub mod io;
+
+mod error;
+mod options;
+
+// The modules below are public only for this repository's command-line tool, tests,
+// benchmarks and examples (and the C ABI's symbols): not part of the library's API, hidden
+// from its documentation, and free to change in any release. Use the items re-exported
+// below instead.
+#[doc(hidden)]
+pub mod capi;
+#[doc(hidden)]
+pub mod front;
+#[doc(hidden)]
+pub mod generate;
+#[doc(hidden)]
+pub mod geom;
+#[doc(hidden)]
 pub mod mesh;
+#[doc(hidden)]
 pub mod optimize;
-pub mod options;
+#[doc(hidden)]
 pub mod surface;
+#[doc(hidden)]
 pub mod threads;
 
 pub use error::{Error, Result, SurfaceDefect};
-pub use generate::{generate, generate_with_progress, Generated};
+pub use front::FrontStats;
+pub use generate::{generate, generate_with_progress, Generated, StageTimes};
+pub use geom::quality::{QualitySummary, TetQualitySummary};
+pub use io::{
+    mesh_to_bytes, read, read_any_surface, read_bytes, read_surface, write_mesh, write_surface,
+    Format, MshVersion, RawMesh, WriteOptions,
+};
+pub use mesh::quality::QualityReport;
+pub use mesh::slivers::SliverCensus;
 pub use mesh::TetMesh;
+pub use optimize::{HighOrderStats, LinearStats, OptimizeStats};
 pub use options::{Options, SizeFrom, SizeMode};
-pub use surface::Surface;
+pub use surface::curve::{CurveOptions, MidpointRule, NormalWeights};
+pub use surface::{Repair, Surface};
 
 /// README.md's Rust example, compiled and run as a doctest so that it cannot go stale.
 #[cfg(doctest)]

@@ -4,6 +4,7 @@ use crate::{Error, Result};
 
 /// How the target element size is chosen.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub enum SizeMode {
     /// Graded from the boundary (default): local size at each surface vertex from its
     /// edges, extended inward with a limited growth rate, never above the largest
@@ -16,9 +17,21 @@ pub enum SizeMode {
     Fixed(f64),
 }
 
+/// In JSON (`curvetet mesh --report`): `"graded"`, `"uniform"`, or the fixed size.
+impl serde::Serialize for SizeMode {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            SizeMode::Graded => s.serialize_str("graded"),
+            SizeMode::Uniform => s.serialize_str("uniform"),
+            SizeMode::Fixed(h) => s.serialize_f64(*h),
+        }
+    }
+}
+
 /// What the graded size field measures each surface vertex's local size from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
+#[non_exhaustive]
 pub enum SizeFrom {
     /// Areas when most of the surface's triangles are elongated (the median vertex's
     /// area size is below [`crate::front::size::AREAS_BELOW`] times its edge size),
@@ -34,8 +47,30 @@ pub enum SizeFrom {
     Areas,
 }
 
-/// Options of mesh generation. `Options::default()` gives the paper's settings.
+/// Options of mesh generation. `Options::default()` gives the paper's settings; the
+/// `with_*` methods change one setting each (new settings can be added without breaking
+/// callers, hence `#[non_exhaustive]`: build from the default, not with a struct literal).
+///
+/// | setting | default | raise it for | lower it for |
+/// |---|---|---|---|
+/// | [`size`](Self::with_size) | graded from the boundary | fewer, larger tets ([`SizeMode::Fixed`]) | — |
+/// | [`gradation`](Self::with_gradation) | 0.2 | faster growth inward: fewer tets | a smoother size field |
+/// | [`alpha`](Self::with_alpha) | 1.5 | more candidate points per face | faster candidate search |
+/// | [`min_dihedral_deg`](Self::with_min_dihedral_deg) | 15 | better tets, a harder front | an easier front |
+/// | [`threads`](Self::with_threads) | 0 (all cores) | — | sharing the machine (results never change) |
+///
+/// ```
+/// use curvetet::{Options, SizeMode};
+///
+/// let opts = Options::default()
+///     .with_size(SizeMode::Fixed(0.3))
+///     .with_threads(2)
+///     .with_thorough(true);
+/// assert!(opts.validate().is_ok());
+/// assert!(Options::default().with_alpha(-1.0).validate().is_err());
+/// ```
 #[derive(Debug, Clone)]
+#[non_exhaustive]
 pub struct Options {
     /// Search radius factor: candidates within `alpha * h` of the ideal point (paper: 1.5).
     pub alpha: f64,
@@ -90,6 +125,73 @@ impl Default for Options {
 }
 
 impl Options {
+    /// With search radius factor `alpha` ([`Options::alpha`]).
+    pub fn with_alpha(mut self, alpha: f64) -> Self {
+        self.alpha = alpha;
+        self
+    }
+
+    /// With target size `size` ([`Options::size`]).
+    pub fn with_size(mut self, size: SizeMode) -> Self {
+        self.size = size;
+        self
+    }
+
+    /// With growth rate `gradation` of the graded size field ([`Options::gradation`]).
+    pub fn with_gradation(mut self, gradation: f64) -> Self {
+        self.gradation = gradation;
+        self
+    }
+
+    /// With the graded size field measuring local sizes from `from` ([`Options::size_from`]).
+    pub fn with_size_from(mut self, from: SizeFrom) -> Self {
+        self.size_from = from;
+        self
+    }
+
+    /// With or without the optimization stages ([`Options::optimize`]). Without them the
+    /// mesh is still certified valid, only of lower quality.
+    pub fn with_optimize(mut self, optimize: bool) -> Self {
+        self.optimize = optimize;
+        self
+    }
+
+    /// With or without the high-order stage's thorough rounds ([`Options::thorough`]).
+    pub fn with_thorough(mut self, thorough: bool) -> Self {
+        self.thorough = thorough;
+        self
+    }
+
+    /// With `threads` worker threads, 0 = all cores ([`Options::threads`]).
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads;
+        self
+    }
+
+    /// With or without pinning workers to CPUs ([`Options::pin_threads`]).
+    pub fn with_pin_threads(mut self, pin: bool) -> Self {
+        self.pin_threads = pin;
+        self
+    }
+
+    /// With minimum candidate dihedral angle `deg` ([`Options::min_dihedral_deg`]).
+    pub fn with_min_dihedral_deg(mut self, deg: f64) -> Self {
+        self.min_dihedral_deg = deg;
+        self
+    }
+
+    /// With maximum candidate skewness `skewness` ([`Options::max_skewness`]).
+    pub fn with_max_skewness(mut self, skewness: f64) -> Self {
+        self.max_skewness = skewness;
+        self
+    }
+
+    /// With minimum edge-face angle `deg` ([`Options::min_edge_face_angle_deg`]).
+    pub fn with_min_edge_face_angle_deg(mut self, deg: f64) -> Self {
+        self.min_edge_face_angle_deg = deg;
+        self
+    }
+
     /// Check every option; a bad one is an [`Error::InvalidArgument`] naming it.
     pub fn validate(&self) -> Result<()> {
         if !(self.alpha.is_finite() && self.alpha > 0.0) {

@@ -782,10 +782,7 @@ fn named_sphere(path: &Path) {
             }
         })
         .collect();
-    let opts = io::WriteOptions {
-        msh_version: io::MshVersion::V22,
-        ..Default::default()
-    };
+    let opts = io::WriteOptions::default().with_msh_version(io::MshVersion::V22);
     io::write_surface(path, &raw.nodes, &raw.tri6, &tags, &opts).unwrap();
     let text = std::fs::read_to_string(path).unwrap();
     // The writer names nothing on a surface of tagged triangles: add the names.
@@ -948,10 +945,7 @@ fn two_region_sphere(path: &Path, one_region: bool) -> usize {
     use std::fmt::Write;
     let raw = curvetet::io::read(&data("sphere_p2.msh")).unwrap();
     let surface = curvetet::io::surface_from_raw(raw, "sphere").unwrap();
-    let opts = curvetet::Options {
-        optimize: false,
-        ..Default::default()
-    };
+    let opts = curvetet::Options::default().with_optimize(false);
     let m = curvetet::generate(&surface, &opts).unwrap().mesh;
     let region: Vec<i32> = m
         .tets
@@ -1173,10 +1167,7 @@ fn progress_reports_the_optimize_stage() {
     let raw = curvetet::io::read(&data("sphere_p2.msh")).unwrap();
     let surface = curvetet::io::surface_from_raw(raw, "sphere").unwrap();
     for optimize in [true, false] {
-        let opts = curvetet::Options {
-            optimize,
-            ..Default::default()
-        };
+        let opts = curvetet::Options::default().with_optimize(optimize);
         let mut stages: Vec<(String, f64)> = Vec::new();
         curvetet::generate_with_progress(&surface, &opts, &mut |f, s| {
             if stages.last().map(|x| x.0.as_str()) != Some(s) || s == "optimize" {

@@ -66,11 +66,9 @@ fn accuracy(name: &str, exact: f64, dist: fn([f64; 3]) -> f64, opts: &CurveOptio
 }
 
 fn with(rule: MidpointRule, normals: NormalWeights) -> CurveOptions {
-    CurveOptions {
-        rule,
-        normals,
-        ..CurveOptions::default()
-    }
+    CurveOptions::default()
+        .with_rule(rule)
+        .with_normals(normals)
 }
 
 /// Measured (see the `curve` module docs): default (arc, Max) ratio 508, distance 2.2e-16;

@@ -43,11 +43,9 @@ fn write_all(mesh: &curvetet::TetMesh) -> Files {
         (Format::Vtu, true, MshVersion::V41),
         (Format::Medit, false, MshVersion::V41),
     ] {
-        let w = WriteOptions {
-            msh_version: version,
-            binary,
-            ..WriteOptions::default()
-        };
+        let w = WriteOptions::default()
+            .with_msh_version(version)
+            .with_binary(binary);
         out.push(mesh_to_bytes(mesh, format, &w).unwrap());
     }
     out
@@ -59,10 +57,7 @@ type Files = Vec<Vec<u8>>;
 /// The output files, or the error message and the files of the mesh it keeps.
 fn mesh_bytes(path: &Path, threads: usize) -> Result<Files, (String, Files)> {
     let s = io::read_surface(path).unwrap();
-    let opts = Options {
-        threads,
-        ..Options::default()
-    };
+    let opts = Options::default().with_threads(threads);
     match generate(&s, &opts) {
         Ok(g) => Ok(write_all(&g.mesh)),
         Err(e) => {

@@ -24,10 +24,7 @@ fn sphere_path() -> PathBuf {
 
 fn expect_invalid(s: &Surface, spec: &str, tet: usize, words: &str) {
     std::env::set_var(INJECT_FAULT_ENV, spec);
-    let opts = Options {
-        threads: 2,
-        ..Options::default()
-    };
+    let opts = Options::default().with_threads(2);
     match generate(s, &opts) {
         Err(Error::InvalidMesh {
             elements,

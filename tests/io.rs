@@ -193,11 +193,9 @@ fn variants() -> Vec<(String, Format, WriteOptions)> {
             v.push((
                 format!("msh{vname}_{}.msh", if binary { "bin" } else { "ascii" }),
                 Format::Msh,
-                WriteOptions {
-                    msh_version: ver,
-                    binary,
-                    ..Default::default()
-                },
+                WriteOptions::default()
+                    .with_msh_version(ver)
+                    .with_binary(binary),
             ));
         }
     }
@@ -205,10 +203,7 @@ fn variants() -> Vec<(String, Format, WriteOptions)> {
         v.push((
             format!("vtu_{}.vtu", if binary { "bin" } else { "ascii" }),
             Format::Vtu,
-            WriteOptions {
-                binary,
-                ..Default::default()
-            },
+            WriteOptions::default().with_binary(binary),
         ));
     }
     v.push(("legacy.vtk".into(), Format::Vtk, WriteOptions::default()));
@@ -220,9 +215,7 @@ fn tet_tag_of(format: Format) -> i32 {
     match format {
         Format::Msh | Format::Medit => VOLUME_TAG,
         Format::Vtu | Format::Vtk => 0,
-        Format::Stl | Format::Off | Format::Obj | Format::Ply => {
-            unreachable!("{format:?} holds no tetrahedra")
-        }
+        _ => unreachable!("{format:?} holds no tetrahedra"),
     }
 }
 
@@ -301,10 +294,7 @@ fn round_trip_every_format_keeps_curved_geometry() {
 #[test]
 fn round_trip_linear_medit_keeps_corners() {
     let mesh = curved_mesh();
-    let opts = WriteOptions {
-        medit_linear: true,
-        ..Default::default()
-    };
+    let opts = WriteOptions::default().with_medit_linear(true);
     let bytes = mesh_to_bytes(&mesh, Format::Medit, &opts).unwrap();
     let back = read_bytes(&bytes, Format::Medit, "lin.mesh").unwrap();
     assert!(back.tri6.is_empty() && back.tet10.is_empty());
@@ -344,11 +334,9 @@ fn non_positive_tags_get_free_positive_groups() {
     let want = vec![1, 5, 2, 5, 1, 5];
     for ver in [MshVersion::V41, MshVersion::V22] {
         for binary in [false, true] {
-            let opts = WriteOptions {
-                msh_version: ver,
-                binary,
-                ..Default::default()
-            };
+            let opts = WriteOptions::default()
+                .with_msh_version(ver)
+                .with_binary(binary);
             let bytes = mesh_to_bytes(&mesh, Format::Msh, &opts).unwrap();
             let back = read_bytes(&bytes, Format::Msh, "t.msh").unwrap();
             assert_eq!(back.tri6_tags, want, "{ver:?} binary {binary}");
@@ -379,10 +367,7 @@ fn writer_rejects_bad_input() {
     mesh.boundary_tags.pop();
     assert!(mesh_to_bytes(&mesh, Format::Vtu, &WriteOptions::default()).is_err());
     let mesh = curved_mesh();
-    let bin = WriteOptions {
-        binary: true,
-        ..Default::default()
-    };
+    let bin = WriteOptions::default().with_binary(true);
     assert!(mesh_to_bytes(&mesh, Format::Vtk, &bin).is_err());
     assert!(mesh_to_bytes(&mesh, Format::Medit, &bin).is_err());
     assert!(io::write_mesh(Path::new("x.stl"), &mesh, &WriteOptions::default()).is_err());
@@ -623,10 +608,7 @@ fn meshio_reads_what_we_write() {
     files.push((
         "linear.mesh".into(),
         Format::Medit,
-        WriteOptions {
-            medit_linear: true,
-            ..Default::default()
-        },
+        WriteOptions::default().with_medit_linear(true),
     ));
     for (file, format, opts) in files {
         let path = dir.join(&file);
@@ -685,10 +667,7 @@ fn gmsh_checks_what_we_write_without_warnings() {
     let mut odd = mesh.clone();
     odd.boundary_tags = vec![0, 5, -3, 5, 0, 5];
     for ver in [MshVersion::V41, MshVersion::V22] {
-        let opts = WriteOptions {
-            msh_version: ver,
-            ..Default::default()
-        };
+        let opts = WriteOptions::default().with_msh_version(ver);
         let name = format!("odd_tags_{ver:?}.msh");
         files.push((name, mesh_to_bytes(&odd, Format::Msh, &opts).unwrap(), 8));
     }
@@ -696,10 +675,7 @@ fn gmsh_checks_what_we_write_without_warnings() {
     let tags: Vec<i32> = (0..sphere.tri6.len()).map(|i| 1 + (i as i32 % 3)).collect();
     for bin in [false, true] {
         let p = dir.join(format!("sphere_{bin}.msh"));
-        let opts = WriteOptions {
-            binary: bin,
-            ..Default::default()
-        };
+        let opts = WriteOptions::default().with_binary(bin);
         io::write_surface(&p, &sphere.nodes, &sphere.tri6, &tags, &opts).unwrap();
         files.push((
             format!("sphere_{bin}.msh"),

@@ -121,21 +121,16 @@ fn written_files() -> Vec<(String, Format, Vec<u8>, usize)> {
     for (mname, m) in [("tet", &mesh), ("sphere", &big)] {
         for (ver, vn) in [(MshVersion::V41, "4.1"), (MshVersion::V22, "2.2")] {
             for bin in [false, true] {
-                let o = WriteOptions {
-                    msh_version: ver,
-                    binary: bin,
-                    ..Default::default()
-                };
+                let o = WriteOptions::default()
+                    .with_msh_version(ver)
+                    .with_binary(bin);
                 let b = mesh_to_bytes(m, Format::Msh, &o).unwrap();
                 let end = last_end(&b, b"$EndElements");
                 out.push((format!("{mname} msh {vn} bin={bin}"), Format::Msh, b, end));
             }
         }
         for bin in [false, true] {
-            let o = WriteOptions {
-                binary: bin,
-                ..Default::default()
-            };
+            let o = WriteOptions::default().with_binary(bin);
             let b = mesh_to_bytes(m, Format::Vtu, &o).unwrap();
             let end = last_end(&b, b"</VTKFile>");
             out.push((format!("{mname} vtu bin={bin}"), Format::Vtu, b, end));

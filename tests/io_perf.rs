@@ -117,11 +117,9 @@ fn million_tets_throughput() {
             continue;
         }
         let path = dir.join(file);
-        let opts = WriteOptions {
-            msh_version: v,
-            binary,
-            ..Default::default()
-        };
+        let opts = WriteOptions::default()
+            .with_msh_version(v)
+            .with_binary(binary);
         let t = Instant::now();
         io::write_mesh(&path, &mesh, &opts).unwrap();
         let tw = t.elapsed();

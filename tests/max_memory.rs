@@ -82,13 +82,7 @@ fn max_memory_refuses_early_and_passes_otherwise() {
 fn estimate_grows_with_input_and_is_below_what_is_measured() {
     let s = io::read_surface(&data("sphere_p2.msh")).unwrap();
     let graded = estimated_peak_memory(&s, &Options::default());
-    let fine = estimated_peak_memory(
-        &s,
-        &Options {
-            size: SizeMode::Fixed(0.01),
-            ..Options::default()
-        },
-    );
+    let fine = estimated_peak_memory(&s, &Options::default().with_size(SizeMode::Fixed(0.01)));
     assert!(graded > 0);
     assert!(fine > 100 * graded, "{fine} vs {graded}");
     // The sphere's graded mesh peaks at a few MiB; the estimate is a lower bound.

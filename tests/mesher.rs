@@ -76,21 +76,9 @@ fn hinge() {
 fn alphas_and_uniform_size() {
     for name in ["sphere", "torus", "tube", "lv", "screw", "hinge"] {
         for alpha in [1.2, 1.5, 2.0, 2.5] {
-            mesh_and_check(
-                name,
-                &Options {
-                    alpha,
-                    ..Options::default()
-                },
-            );
+            mesh_and_check(name, &Options::default().with_alpha(alpha));
         }
-        mesh_and_check(
-            name,
-            &Options {
-                size: SizeMode::Uniform,
-                ..Options::default()
-            },
-        );
+        mesh_and_check(name, &Options::default().with_size(SizeMode::Uniform));
     }
 }
 
@@ -98,26 +86,11 @@ fn alphas_and_uniform_size() {
 fn bad_options_are_clear_errors() {
     let s = io::read_surface(&data("sphere_p2.msh")).unwrap();
     for o in [
-        Options {
-            alpha: 0.0,
-            ..Options::default()
-        },
-        Options {
-            alpha: -1.0,
-            ..Options::default()
-        },
-        Options {
-            alpha: f64::NAN,
-            ..Options::default()
-        },
-        Options {
-            size: SizeMode::Fixed(f64::NAN),
-            ..Options::default()
-        },
-        Options {
-            size: SizeMode::Fixed(0.0),
-            ..Options::default()
-        },
+        Options::default().with_alpha(0.0),
+        Options::default().with_alpha(-1.0),
+        Options::default().with_alpha(f64::NAN),
+        Options::default().with_size(SizeMode::Fixed(f64::NAN)),
+        Options::default().with_size(SizeMode::Fixed(0.0)),
     ] {
         let e = generate(&s, &o).unwrap_err();
         assert!(matches!(e, curvetet::Error::InvalidArgument(_)), "{e}");
@@ -189,10 +162,7 @@ fn marching_cubes_surface_smoothed_then_meshed() {
     use curvetet::surface::curve::{curve_linear, CurveOptions};
     let raw = io::read(&data("mc_blob.off")).expect("reads");
     let curve = |k: u32| {
-        let opts = CurveOptions {
-            smooth_iterations: k,
-            ..CurveOptions::default()
-        };
+        let opts = CurveOptions::default().with_smooth_iterations(k);
         curve_linear(raw.nodes.clone(), raw.tri3.clone(), vec![], &opts).expect("curves")
     };
     let (rough, smooth) = (curve(0), curve(10));

@@ -127,14 +127,7 @@ fn staged_rounds_go_on_while_they_reach_their_aim() {
 fn thorough_rounds_leave_fewer_elements_below_the_threshold() {
     let Some(s) = surface("screw") else { return };
     let quick = generate(&s, &Options::default()).expect("screw");
-    let thorough = generate(
-        &s,
-        &Options {
-            thorough: true,
-            ..Options::default()
-        },
-    )
-    .expect("screw, thorough");
+    let thorough = generate(&s, &Options::default().with_thorough(true)).expect("screw, thorough");
     let (q, t) = (&quick.optimize.high_order, &thorough.optimize.high_order);
     eprintln!("default: {q:?}\nthorough: {t:?}");
     // The same front and linear stage: the staged high-order rounds differ.
@@ -160,10 +153,7 @@ fn thorough_rounds_leave_fewer_elements_below_the_threshold() {
 fn same_mesh_for_one_and_two_threads() {
     let Some(s) = surface("sphere") else { return };
     let run = |threads| {
-        let o = Options {
-            threads,
-            ..Options::default()
-        };
+        let o = Options::default().with_threads(threads);
         generate(&s, &o).expect("sphere meshes").mesh
     };
     let (a, b) = (run(1), run(2));
@@ -186,10 +176,7 @@ fn optimization_keeps_the_boundary_nodes_and_can_be_turned_off() {
         .zip(&g.mesh.nodes[..n])
         .all(|(p, q)| p.map(f64::to_bits) == q.map(f64::to_bits)));
     assert_eq!(g.mesh.boundary, s.triangles());
-    let o = Options {
-        optimize: false,
-        ..Options::default()
-    };
+    let o = Options::default().with_optimize(false);
     let raw = generate(&s, &o).expect("sphere meshes");
     assert_eq!(raw.optimize.linear.passes, 0);
     assert!(

@@ -34,10 +34,9 @@ fn corpus_surface_with(path: &std::path::Path, repair: Repair) -> Result<Surface
     } else {
         let raw = io::read(path).unwrap_or_else(|e| panic!("{name}: the reader failed: {e}"));
         assert!(raw.tri6.is_empty(), "{name}: not a linear file");
-        let opts = CurveOptions {
-            repair,
-            ..CurveOptions::with_feature_angle(40.0)
-        };
+        let opts = CurveOptions::default()
+            .with_feature_angle_deg(40.0)
+            .with_repair(repair);
         curve_linear(raw.nodes, raw.tri3, raw.tri3_tags, &opts)
     }
 }

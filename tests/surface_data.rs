@@ -78,10 +78,7 @@ fn poorly_shaped_surfaces_warn() {
     use curvetet::surface::curve::CurveOptions;
     let path = data_dir().join("mc_blob.off");
     let surface = |smooth_iterations| {
-        let opts = CurveOptions {
-            smooth_iterations,
-            ..CurveOptions::default()
-        };
+        let opts = CurveOptions::default().with_smooth_iterations(smooth_iterations);
         curvetet::io::read_any_surface(&path, &opts).expect("curves")
     };
     let w = surface(0).warnings().to_vec();

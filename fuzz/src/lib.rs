@@ -206,11 +206,9 @@ pub fn mesh_icosphere_strict(data: &[u8], strict: bool) {
         Ok(s) => s,
         Err(e) => return check_error(&e),
     };
-    let mut opts = Options {
-        threads: 1,
-        optimize: mode & 8 != 0,
-        ..Options::default()
-    };
+    let mut opts = Options::default()
+        .with_threads(1)
+        .with_optimize(mode & 8 != 0);
     match (mode >> 4) & 3 {
         0 => opts.size = SizeMode::Graded,
         1 => opts.size = SizeMode::Uniform,

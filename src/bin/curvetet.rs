@@ -183,11 +183,10 @@ struct CurveArgs {
 
 impl CurveArgs {
     fn options(&self) -> CurveOptions {
-        CurveOptions {
-            smooth_iterations: self.smooth,
-            repair: self.repair(),
-            ..CurveOptions::with_feature_angle(self.feature_angle)
-        }
+        CurveOptions::default()
+            .with_feature_angle_deg(self.feature_angle)
+            .with_smooth_iterations(self.smooth)
+            .with_repair(self.repair())
     }
 
     fn repair(&self) -> Repair {
@@ -264,42 +263,38 @@ struct WriteArgs {
 
 impl WriteArgs {
     fn options(&self) -> WriteOptions {
-        WriteOptions {
-            msh_version: if self.msh22 {
+        WriteOptions::default()
+            .with_msh_version(if self.msh22 {
                 MshVersion::V22
             } else {
                 MshVersion::V41
-            },
-            binary: self.binary,
+            })
+            .with_binary(self.binary)
             // The VTK filter's per-tet quality arrays, in .vtu and .vtk meshes.
-            quality_arrays: true,
-            ..WriteOptions::default()
-        }
+            .with_quality_arrays(true)
     }
 }
 
 impl MeshOptions {
     fn options(&self) -> Options {
-        Options {
-            alpha: self.alpha,
-            size: match (self.size, self.uniform_size) {
+        Options::default()
+            .with_alpha(self.alpha)
+            .with_size(match (self.size, self.uniform_size) {
                 (Some(h), _) => SizeMode::Fixed(h),
                 (None, true) => SizeMode::Uniform,
                 (None, false) => SizeMode::Graded,
-            },
-            size_from: match self.size_from {
+            })
+            .with_size_from(match self.size_from {
                 SizeFromArg::Auto => SizeFrom::Auto,
                 SizeFromArg::Edges => SizeFrom::Edges,
                 SizeFromArg::Areas => SizeFrom::Areas,
-            },
-            optimize: !self.no_optimize,
-            thorough: self.thorough,
-            threads: self.threads,
+            })
+            .with_optimize(!self.no_optimize)
+            .with_thorough(self.thorough)
+            .with_threads(self.threads)
             // The command owns its process: keep each worker on its own CPU (see
             // curvetet::threads; CURVETET_PIN_THREADS=0 turns it off).
-            pin_threads: true,
-            ..Options::default()
-        }
+            .with_pin_threads(true)
     }
 }
 
@@ -391,17 +386,10 @@ fn main() -> ExitCode {
     }
 }
 
-/// The exit codes ([`EXIT_CODES`]): the C ABI's status codes.
+/// The exit codes ([`EXIT_CODES`]): the C ABI's status codes (1 to 7; its one mapping,
+/// which matches every kind of error).
 fn exit_code(e: &Error) -> u8 {
-    match e {
-        Error::InvalidArgument(_) => 1,
-        Error::Io { .. } => 2,
-        Error::Parse { .. } => 3,
-        Error::InvalidSurface { .. } => 4,
-        Error::MeshingFailed { .. } => 5,
-        Error::InvalidMesh { .. } => 6,
-        Error::Cancelled => 7,
-    }
+    curvetet::capi::curvetet_status::of(e) as u8
 }
 
 /// Print a line of results on stdout. A closed stdout (`curvetet check X | head -1`) is
@@ -436,11 +424,7 @@ fn progress_bar(quiet: bool) -> ProgressBar {
 fn options_json(o: &Options, w: &WriteOptions) -> serde_json::Value {
     serde_json::json!({
         "alpha": o.alpha,
-        "size": match o.size {
-            SizeMode::Graded => serde_json::json!("graded"),
-            SizeMode::Uniform => serde_json::json!("uniform"),
-            SizeMode::Fixed(h) => serde_json::json!(h),
-        },
+        "size": o.size,
         "size_from": o.size_from,
         "gradation": o.gradation,
         "optimize": o.optimize,
@@ -449,10 +433,7 @@ fn options_json(o: &Options, w: &WriteOptions) -> serde_json::Value {
         "min_dihedral_deg": o.min_dihedral_deg,
         "max_skewness": o.max_skewness,
         "min_edge_face_angle_deg": o.min_edge_face_angle_deg,
-        "msh_version": match w.msh_version {
-            MshVersion::V41 => "4.1",
-            MshVersion::V22 => "2.2",
-        },
+        "msh_version": w.msh_version.as_str(),
         "binary": w.binary,
     })
 }

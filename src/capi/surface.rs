@@ -371,11 +371,10 @@ unsafe fn from_linear_call(
         };
         let nodes: Vec<[f64; 3]> = copy_groups(xyz, "xyz")?;
         let tris: Vec<[u32; 3]> = copy_groups(tri3, "tri3")?;
-        let opts = crate::surface::curve::CurveOptions {
-            smooth_iterations,
-            repair: repair_of(flags)?,
-            ..crate::surface::curve::CurveOptions::with_feature_angle(feature_angle_deg)
-        };
+        let opts = crate::surface::curve::CurveOptions::default()
+            .with_feature_angle_deg(feature_angle_deg)
+            .with_smooth_iterations(smooth_iterations)
+            .with_repair(repair_of(flags)?);
         let s = crate::surface::curve::curve_linear(nodes, tris, tags, &opts)?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };

@@ -319,6 +319,7 @@ impl Histogram {
 /// min / max / mean and a histogram of one quality measure over a mesh. NaN values are
 /// counted in the histogram only.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct QualitySummary {
     /// Number of (non-NaN) values.
     pub count: u64,
@@ -395,6 +396,7 @@ impl QualitySummary {
 /// scaled Jacobians and skewness over [0, 1] in 20 bins, dihedral angles over [0, 180]
 /// in 36 bins.
 #[derive(Clone, Debug, PartialEq, Serialize)]
+#[non_exhaustive]
 pub struct TetQualitySummary {
     /// Sampled scaled Jacobian.
     pub scaled_jacobian: QualitySummary,

@@ -174,6 +174,7 @@ impl RawMesh {
 
 /// A mesh file format.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Format {
     /// Gmsh `.msh`.
     Msh,
@@ -320,6 +321,7 @@ fn indices_in_range(m: &RawMesh) -> bool {
 
 /// Gmsh .msh file format version to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum MshVersion {
     /// MSH 4.1 (Gmsh's current format).
     #[default]
@@ -328,8 +330,29 @@ pub enum MshVersion {
     V22,
 }
 
-/// How to write a mesh file.
+impl MshVersion {
+    /// The version as Gmsh writes it in `$MeshFormat`: `"4.1"` or `"2.2"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MshVersion::V41 => "4.1",
+            MshVersion::V22 => "2.2",
+        }
+    }
+}
+
+/// How to write a mesh file. `WriteOptions::default()` writes ASCII .msh 4.1; the `with_*`
+/// methods change one setting each.
+///
+/// ```
+/// use curvetet::{Format, MshVersion, WriteOptions};
+///
+/// let opts = WriteOptions::default().with_msh_version(MshVersion::V22).with_binary(true);
+/// assert!(curvetet::io::check_write_options(Format::Msh, &opts).is_ok());
+/// // Legacy .vtk is ASCII only: asking for binary is an error, not a silent fallback.
+/// assert!(curvetet::io::check_write_options(Format::Vtk, &opts).is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub struct WriteOptions {
     /// Version of .msh files (default 4.1).
     pub msh_version: MshVersion,
@@ -343,6 +366,33 @@ pub struct WriteOptions {
     /// max J) and `EquiangularSkewness` of each tetrahedron (0 for the triangles), as the
     /// VTK filter's output has.
     pub quality_arrays: bool,
+}
+
+impl WriteOptions {
+    /// With .msh version `version` ([`WriteOptions::msh_version`]).
+    pub fn with_msh_version(mut self, version: MshVersion) -> Self {
+        self.msh_version = version;
+        self
+    }
+
+    /// With binary encoding on or off ([`WriteOptions::binary`]).
+    pub fn with_binary(mut self, binary: bool) -> Self {
+        self.binary = binary;
+        self
+    }
+
+    /// With linear medit sections on or off ([`WriteOptions::medit_linear`]).
+    pub fn with_medit_linear(mut self, linear: bool) -> Self {
+        self.medit_linear = linear;
+        self
+    }
+
+    /// With the per-element quality arrays of .vtu/.vtk on or off
+    /// ([`WriteOptions::quality_arrays`]).
+    pub fn with_quality_arrays(mut self, on: bool) -> Self {
+        self.quality_arrays = on;
+        self
+    }
 }
 
 /// What the writers see: a validated P2 mesh or surface.

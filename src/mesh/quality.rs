@@ -35,6 +35,7 @@ pub fn uncertified(m: &TetMesh) -> Vec<usize> {
 
 /// What users and the paper measure on a mesh.
 #[derive(Debug, Clone, serde::Serialize)]
+#[non_exhaustive]
 pub struct QualityReport {
     /// Number of 10-node tets.
     pub num_tets: usize,

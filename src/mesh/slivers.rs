@@ -18,6 +18,7 @@ pub const SMALL_ANGLE_DEG: f64 = 20.0;
 
 /// How many slivers a mesh has, forced by the input or not.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize)]
+#[non_exhaustive]
 pub struct SliverCensus {
     /// Slivers the input forces (see the module documentation).
     pub forced: usize,

@@ -27,6 +27,7 @@ pub use linear::{improve_linear, improve_linear_known, LinearParams, LinearStats
 
 /// What the optimization stages did (part of [`crate::Generated`]).
 #[derive(Debug, Clone, Default, serde::Serialize)]
+#[non_exhaustive]
 pub struct OptimizeStats {
     /// The linear (straight-sided) stage.
     pub linear: LinearStats,

@@ -23,6 +23,7 @@ use std::collections::VecDeque;
 /// Whether building a [`Surface`](super::Surface) repairs what is unambiguous in its
 /// input (see the [module docs](self)).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum Repair {
     /// Drop unused nodes and reorient inconsistently oriented shells, each with a warning
     /// (the default).

@@ -66,7 +66,7 @@ pub struct RoundTuning {
 /// element evaluations instead of 50k, certified min J / max J 0.630 instead of 0.626,
 /// but 204 elements left below the threshold instead of 78 (mean 0.891 instead of
 /// 0.924); on the hinge the same minimum (0.436), 125k evaluations instead of 282k, max
-/// skewness 0.831 instead of 0.812. `examples/optimize_tradeoff` measures both.
+/// skewness 0.831 instead of 0.812. `examples/benchmarks/optimize_tradeoff.rs` measures both.
 #[derive(Clone, Debug)]
 pub struct HighOrderParams {
     /// Elements with certified min J / max J below this seed patches.
@@ -178,6 +178,7 @@ struct RoundPrm<'p> {
 
 /// What the high-order stage did.
 #[derive(Debug, Clone, Default, serde::Serialize)]
+#[non_exhaustive]
 pub struct HighOrderStats {
     /// Certified min of min J / max J over the mesh, before and after.
     pub min_scaled_jacobian: [f64; 2],

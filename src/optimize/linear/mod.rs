@@ -86,6 +86,7 @@ impl Default for LinearParams {
 
 /// What the linear stage did.
 #[derive(Debug, Clone, Default, serde::Serialize)]
+#[non_exhaustive]
 pub struct LinearStats {
     /// Tets before and after.
     pub tets: [usize; 2],

@@ -62,6 +62,7 @@ use midpoint::{arc_mid, pn_mid, tangent_from_normal};
 
 /// How a smooth (non-feature) edge's mid node is placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum MidpointRule {
     /// The arc with the end tangents taken from the vertex normals (exact on spheres).
     #[default]
@@ -85,6 +86,7 @@ pub enum MidpointRule {
 /// length)^2, so on meshes that mix very small and large triangles the small ones
 /// dominate; `Angle` is the more even-handed choice there.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
 pub enum NormalWeights {
     /// Max (1999): (u x w) / (|u|^2 |w|^2) per wedge; exact on spheres.
     #[default]
@@ -93,8 +95,19 @@ pub enum NormalWeights {
     Angle,
 }
 
-/// Options of [`curve_linear`].
+/// Options of [`curve_linear`]. `CurveOptions::default()` gives the settings that suit
+/// most CAD and scanned surfaces; the `with_*` methods change one setting each.
+///
+/// ```
+/// use curvetet::CurveOptions;
+///
+/// // A faceted part: treat edges sharper than 30 degrees as features, keep the rest smooth.
+/// let opts = CurveOptions::default().with_feature_angle_deg(30.0);
+/// assert!(opts.validate().is_ok());
+/// assert!(CurveOptions::default().with_feature_angle_deg(200.0).validate().is_err());
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct CurveOptions {
     /// An edge whose two triangles' normals differ by more than this angle (degrees) is a
     /// feature (sharp) edge: normals are not averaged across it and its mid node follows
@@ -141,12 +154,40 @@ impl Default for CurveOptions {
 }
 
 impl CurveOptions {
-    /// Default options with feature angle `deg`.
-    pub fn with_feature_angle(deg: f64) -> Self {
-        CurveOptions {
-            feature_angle_deg: deg,
-            ..CurveOptions::default()
-        }
+    /// With feature angle `deg` ([`CurveOptions::feature_angle_deg`]).
+    pub fn with_feature_angle_deg(mut self, deg: f64) -> Self {
+        self.feature_angle_deg = deg;
+        self
+    }
+
+    /// With smallest admitted normal cosine `cos` ([`CurveOptions::min_normal_cosine`]).
+    pub fn with_min_normal_cosine(mut self, cos: f64) -> Self {
+        self.min_normal_cosine = cos;
+        self
+    }
+
+    /// With mid-node rule `rule` ([`CurveOptions::rule`]).
+    pub fn with_rule(mut self, rule: MidpointRule) -> Self {
+        self.rule = rule;
+        self
+    }
+
+    /// With vertex-normal weights `normals` ([`CurveOptions::normals`]).
+    pub fn with_normals(mut self, normals: NormalWeights) -> Self {
+        self.normals = normals;
+        self
+    }
+
+    /// With `n` smoothing iterations before curving ([`CurveOptions::smooth_iterations`]).
+    pub fn with_smooth_iterations(mut self, n: u32) -> Self {
+        self.smooth_iterations = n;
+        self
+    }
+
+    /// With repairs `repair` allowed or refused ([`CurveOptions::repair`]).
+    pub fn with_repair(mut self, repair: Repair) -> Self {
+        self.repair = repair;
+        self
     }
 
     /// Check every option; a bad one is an [`Error::InvalidArgument`] naming it. Callers
@@ -180,6 +221,7 @@ impl CurveOptions {
 
 /// What curving did, for reports.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct CurveReport {
     /// Edges (= mid nodes).
     pub edges: usize,
@@ -452,7 +494,7 @@ impl Surface {
             nodes,
             tri3,
             tags,
-            &CurveOptions::with_feature_angle(feature_angle_deg),
+            &CurveOptions::default().with_feature_angle_deg(feature_angle_deg),
         )
     }
 }

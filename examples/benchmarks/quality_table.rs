@@ -52,17 +52,8 @@ fn main() {
             }
         };
         // Timed as `curvetet mesh` runs: each worker on its own CPU.
-        let opts = Options {
-            pin_threads: true,
-            ..Options::default()
-        };
-        let raw = generate(
-            &surface,
-            &Options {
-                optimize: false,
-                ..opts.clone()
-            },
-        );
+        let opts = Options::default().with_pin_threads(true);
+        let raw = generate(&surface, &opts.clone().with_optimize(false));
         let g = match generate(&surface, &opts) {
             Ok(g) => g,
             Err(e) => {
