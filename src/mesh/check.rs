@@ -11,9 +11,9 @@
 
 use super::TetMesh;
 use crate::geom::predicates::orient3d;
-use crate::geom::quadrature::CompensatedSum;
+use crate::geom::quadrature::{enclosed_volume_linear, CompensatedSum};
 use crate::geom::shape::{TET10_EDGES, TET_OUT_FACES as OUT, TRI6_EDGES};
-use crate::geom::vec3::{det3, sub, tet_det};
+use crate::geom::vec3::tet_det;
 use crate::{Error, Result};
 
 fn compensated_sum(xs: impl Iterator<Item = f64>) -> f64 {
@@ -279,15 +279,14 @@ pub fn check_conformity_regions(m: &TetMesh, regions: &[i32]) -> Result<Conformi
             .iter()
             .map(|t| tet_det(p(t[0]), p(t[1]), p(t[2]), p(t[3])) / 6.0),
     );
-    // Divergence theorem about a node of the mesh (not the origin) to keep precision.
-    let o = m.boundary.first().map(|b| p(b[0])).unwrap_or([0.0; 3]);
-    let enclosed_linear = compensated_sum(
-        m.boundary
-            .iter()
-            .zip(&outer)
-            .filter(|(_, &on_outer)| on_outer)
-            .map(|(b, _)| det3(sub(p(b[0]), o), sub(p(b[1]), o), sub(p(b[2]), o)) / 6.0),
-    );
+    let outer_tris: Vec<[u32; 6]> = m
+        .boundary
+        .iter()
+        .zip(&outer)
+        .filter(|(_, &on_outer)| on_outer)
+        .map(|(b, _)| *b)
+        .collect();
+    let enclosed_linear = enclosed_volume_linear(&m.nodes, &outer_tris);
     Ok(Conformity {
         tets: m.tets.len(),
         interior_faces: interior,

@@ -52,15 +52,3 @@ pub fn curved_volume(nodes: &[P3], tris: &[[u32; 6]]) -> f64 {
     }
     v / 3.0
 }
-
-/// Volume enclosed by the chord (corner) triangles (positive when outward).
-pub fn chord_volume(nodes: &[P3], tris: &[[u32; 6]]) -> f64 {
-    let o = centre(nodes);
-    tris.iter()
-        .map(|t| {
-            let [a, b, c] = [0, 1, 2].map(|k| sub(nodes[t[k] as usize], o));
-            crate::geom::vec3::det3(a, b, c)
-        })
-        .sum::<f64>()
-        / 6.0
-}

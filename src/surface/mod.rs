@@ -367,9 +367,10 @@ impl Surface {
         measure::curved_volume(&self.nodes, &self.tris)
     }
 
-    /// Volume enclosed by the chord (corner-only) triangles.
+    /// Volume enclosed by the chord (corner-only) triangles
+    /// ([`enclosed_volume_linear`](crate::geom::quadrature::enclosed_volume_linear)).
     pub fn chord_volume(&self) -> f64 {
-        measure::chord_volume(&self.nodes, &self.tris)
+        crate::geom::quadrature::enclosed_volume_linear(&self.nodes, &self.tris)
     }
 
     /// Smallest cosine between the curved normal and the chord normal over all
