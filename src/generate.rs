@@ -7,7 +7,7 @@ use crate::geom::quadrature::tri6_area;
 #[cfg(feature = "fault-injection")]
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
-use crate::mesh::quality::{uncertified, QualityReport};
+use crate::mesh::report::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
 use crate::optimize::{
     improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams,

@@ -67,7 +67,7 @@ pub use io::{
     mesh_to_bytes, read, read_any_surface, read_bytes, read_surface, write_mesh, write_surface,
     Format, MshVersion, RawMesh, WriteOptions,
 };
-pub use mesh::quality::QualityReport;
+pub use mesh::report::QualityReport;
 pub use mesh::slivers::SliverCensus;
 pub use mesh::TetMesh;
 pub use optimize::{HighOrderStats, LinearStats, OptimizeStats};

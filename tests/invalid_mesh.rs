@@ -105,7 +105,7 @@ fn corrupted_meshes_are_never_returned() {
     assert_eq!(g.front.restarts, 1);
     assert_eq!(g.front.alpha, 0.8 * Options::default().alpha);
     assert_eq!(g.report.num_invalid, 0);
-    assert!(curvetet::mesh::quality::uncertified(&g.mesh).is_empty());
+    assert!(curvetet::mesh::report::uncertified(&g.mesh).is_empty());
     assert_eq!(clean.front.restarts, 0);
 
     // C ABI.

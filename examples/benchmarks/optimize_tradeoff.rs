@@ -16,7 +16,7 @@
 use curvetet::front::run_front;
 use curvetet::generate::size_field;
 use curvetet::mesh::build::assemble;
-use curvetet::mesh::quality::{uncertified, QualityReport};
+use curvetet::mesh::report::{uncertified, QualityReport};
 use curvetet::optimize::{
     improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams, RoundTuning,
 };

@@ -2,7 +2,7 @@
 
 use curvetet::io::{read_bytes, surface_from_raw_any, Format, RawMesh};
 use curvetet::mesh::check::check_conformity;
-use curvetet::mesh::quality::uncertified;
+use curvetet::mesh::report::uncertified;
 use curvetet::surface::curve::CurveOptions;
 use curvetet::surface::demo::icosphere;
 use curvetet::{generate, Error, Options, SizeMode, Surface};

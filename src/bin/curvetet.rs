@@ -4,7 +4,7 @@
 use clap::{Args, Parser, Subcommand};
 use curvetet::geom::quadrature::{enclosed_volume, enclosed_volume_linear};
 use curvetet::io::{self, MshVersion, WriteOptions};
-use curvetet::mesh::quality::QualityReport;
+use curvetet::mesh::report::QualityReport;
 use curvetet::mesh::{check, TetMesh};
 use curvetet::surface::curve::{curve_linear_report, CurveOptions, CurveReport};
 use curvetet::surface::geometry::{

@@ -7,7 +7,7 @@ use super::status::{curvetet_status, CURVETET_ERR_CANCELLED};
 use super::surface::{c_path, curvetet_surface, reset_out};
 use crate::io::order::{tet10_to, Convention};
 use crate::io::{MshVersion, WriteOptions};
-use crate::mesh::quality::{element_qualities, QualityReport};
+use crate::mesh::report::{element_qualities, QualityReport};
 use crate::{generate_with_progress, Error, Generated};
 use std::ffi::{c_char, c_int, CString};
 use std::mem::{offset_of, size_of};

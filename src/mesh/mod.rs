@@ -26,5 +26,5 @@ pub struct TetMesh {
 pub mod build;
 pub mod check;
 pub mod plot;
-pub mod quality;
+pub mod report;
 pub mod slivers;

@@ -2,7 +2,7 @@
 //! equiangular skewness), drawn as a self-contained SVG. Hand-written: two bar charts
 //! are a few dozen lines, not worth a plotting dependency.
 
-use super::quality::QualityReport;
+use super::report::QualityReport;
 use crate::geom::quality::Histogram;
 use std::fmt::Write;
 

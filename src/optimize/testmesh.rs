@@ -208,7 +208,7 @@ mod tests {
             let m = c.p2();
             let conf = crate::mesh::check::check_conformity(&m).unwrap();
             assert!((conf.volume_linear - 1.0).abs() < 1e-12);
-            assert!(crate::mesh::quality::uncertified(&m).is_empty());
+            assert!(crate::mesh::report::uncertified(&m).is_empty());
         }
     }
 }

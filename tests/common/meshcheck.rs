@@ -5,7 +5,7 @@ use curvetet::geom::predicates::orient3d;
 use curvetet::geom::quadrature::{
     enclosed_volume, enclosed_volume_linear, tet10_volume, CompensatedSum,
 };
-use curvetet::mesh::quality::tet_nodes;
+use curvetet::mesh::report::tet_nodes;
 use curvetet::{Surface, TetMesh};
 use std::collections::HashMap;
 

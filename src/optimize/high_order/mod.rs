@@ -24,7 +24,7 @@ mod schedule;
 use crate::geom::predicates::orient3d;
 use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::{dist, mid, P3};
-use crate::mesh::quality::tet_nodes;
+use crate::mesh::report::tet_nodes;
 use crate::mesh::TetMesh;
 use crate::optimize::Boundary;
 use lanes::L;
@@ -666,7 +666,7 @@ fn skew(x: &[P3; 10]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::quality::uncertified;
+    use crate::mesh::report::uncertified;
     use crate::optimize::testmesh::cube;
 
     /// A free (interior, non-corner) mid node of `m` near the cube's centre.

@@ -8,7 +8,7 @@
 //! the minimum quality of the tets it touches.
 
 use super::mesh::{face_opposite, opposite_edge, LinMesh};
-use super::quality::{cut_bound, ruled_out};
+use super::objective::{cut_bound, ruled_out};
 
 /// Largest edge ring edge removal tries.
 pub(super) const MAX_RING: usize = 10;
@@ -178,7 +178,7 @@ pub(super) fn remove_edge(m: &mut LinMesh, a: u32, b: u32, eps: f64, s: &mut Fli
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimize::linear::quality::ElementQuality;
+    use crate::optimize::linear::objective::ElementQuality;
     use crate::optimize::testmesh::{cube, edges, jittered};
 
     /// Every edge removal of a jittered cube, made whatever it gives (a minimum to beat of

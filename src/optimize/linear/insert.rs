@@ -5,7 +5,7 @@
 //! (a sliver across a thin wall, say) a vertex that can move.
 
 use super::mesh::{opposite_edge, LinMesh};
-use super::quality::{cut_bound, ruled_out};
+use super::objective::{cut_bound, ruled_out};
 use super::smooth::{smooth_vertex, SmoothParams, SmoothScratch};
 use crate::geom::vec3::mid;
 
@@ -112,7 +112,7 @@ pub(super) fn split_edge(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optimize::linear::quality::ElementQuality;
+    use crate::optimize::linear::objective::ElementQuality;
     use crate::optimize::testmesh::{cube, edges, jittered};
 
     /// Every split of a jittered cube, its new vertex smoothed and the split kept whatever

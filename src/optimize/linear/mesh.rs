@@ -1,7 +1,7 @@
 //! A mutable straight-sided tet mesh with vertex → tet incidence: what the local
 //! operations of the linear stage edit.
 
-use super::quality::ElementQuality;
+use super::objective::ElementQuality;
 use crate::geom::vec3::P3;
 use crate::optimize::Boundary;
 

@@ -1,7 +1,7 @@
 //! Linear quality improvement of the straight-sided core, before P2 assembly.
 //!
 //! Worst element first: every tet whose quality (1 − equiangular skewness, see
-//! [`quality`]) is below the goal is attacked in turn by edge removal on its edges, 2-3
+//! [`objective`]) is below the goal is attacked in turn by edge removal on its edges, 2-3
 //! flips on its faces, smoothing of its interior vertices, contraction of its edges
 //! that have an interior end point, and insertion of a vertex on one of its interior
 //! edges (longest first); an operation is kept only when it raises the minimum quality
@@ -17,7 +17,7 @@ mod contract;
 mod flips;
 mod insert;
 mod mesh;
-mod quality;
+mod objective;
 mod smooth;
 
 use crate::geom::shape::TET10_EDGES;
@@ -27,7 +27,7 @@ use contract::{contract, ContractScratch};
 use flips::{flip23, remove_edge, FlipScratch};
 use insert::{split_edge, InsertScratch};
 use mesh::LinMesh;
-pub use quality::ElementQuality;
+pub use objective::ElementQuality;
 use smooth::{search_vertex, smooth_vertex, SmoothParams, SmoothScratch};
 
 /// Tuning of the linear stage.
@@ -628,7 +628,7 @@ mod tests {
         let mesh = crate::mesh::build::assemble(&pts2, &tets2, c.n_surf, &c.tris, &[]);
         let conf = crate::mesh::check::check_conformity(&mesh).unwrap();
         assert!((conf.volume_linear - 1.0).abs() < 1e-12);
-        assert!(crate::mesh::quality::uncertified(&mesh).is_empty());
+        assert!(crate::mesh::report::uncertified(&mesh).is_empty());
         // Deterministic.
         let (pts3, tets3, _) = improve_linear(pts, c.tets.clone(), &bnd, &LinearParams::default());
         assert_eq!(tets2, tets3);

@@ -6,7 +6,7 @@
 //! Boundary vertices are never moved.
 
 use super::mesh::LinMesh;
-use super::quality::skew_pieces;
+use super::objective::skew_pieces;
 use crate::geom::vec3::{dist2, dot, norm, P3};
 
 /// Tuning of the smoother.
