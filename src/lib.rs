@@ -61,8 +61,10 @@ pub mod threads;
 
 pub use error::{Error, Result, SurfaceDefect};
 pub use front::FrontStats;
-pub use generate::{generate, generate_with_progress, Generated, StageTimes};
-pub use geom::quality::{QualitySummary, TetQualitySummary};
+pub use generate::{
+    estimated_peak_memory, generate, generate_with_progress, Generated, StageTimes,
+};
+pub use geom::tet_quality::{QualitySummary, TetQualitySummary};
 pub use io::{
     mesh_to_bytes, read, read_any_surface, read_bytes, read_surface, write_mesh, write_surface,
     Format, MshVersion, RawMesh, WriteOptions,

@@ -5,7 +5,7 @@
 //! leaves a message for `curvetet_last_error_message()`; getters take `const` handles.
 //!
 //! Rules every entry point follows:
-//! - the body runs inside `catch_unwind` ([`guard`]): nothing unwinds into C; a panic
+//! - the body runs inside `catch_unwind` (`guard`): nothing unwinds into C; a panic
 //!   becomes `CURVETET_ERR_PANIC` with the panic message;
 //! - pointers are checked for NULL and alignment, counts for overflow, before any slice
 //!   is made from them; enums and versioned structs coming from C are validated

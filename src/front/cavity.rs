@@ -10,7 +10,7 @@
 use super::validity::{self, FaceRef, TET_OUT_FACES};
 use super::Mesher;
 use crate::geom::predicates::orient3d;
-use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
+use crate::geom::tet_quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::*;
 
 /// Largest cavity (front faces) the exact search takes on.

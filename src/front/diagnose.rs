@@ -6,7 +6,7 @@ use super::size::regular_height;
 use super::validity;
 use super::Mesher;
 use crate::geom::predicates::orient3d;
-use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
+use crate::geom::tet_quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::*;
 use std::fmt::Write;
 

@@ -19,8 +19,8 @@ pub mod validity;
 
 use crate::geom::bezier::certify;
 use crate::geom::predicates::orient3d;
-use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::shape::{tri6_normal, TET10_EDGES};
+use crate::geom::tet_quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::*;
 use crate::options::Options;
 use crate::{Error, Result};
@@ -28,7 +28,7 @@ use grid::{Aabb, FaceGrid, PointGrid};
 use queue::FaceQueue;
 use rustc_hash::FxHashMap as HashMap;
 use size::{regular_height, SizeField};
-use validity::{FaceRef, TET_OUT_FACES};
+use validity::{FaceRef, NEW_POINT, TET_OUT_FACES};
 
 /// What the front produced: straight-sided tets on low-order vertices.
 pub struct FrontOutput {
@@ -37,7 +37,7 @@ pub struct FrontOutput {
     /// Positive tets (corner ids).
     pub tets: Vec<[u32; 4]>,
     /// Per tet: 1 − equiangular skewness of its corners as the front measured it when it
-    /// chose the tet (`geom::quality`, the corners in tet order), NaN where it did not
+    /// chose the tet (`geom::tet_quality`, the corners in tet order), NaN where it did not
     /// measure (tets of filled cavities). The linear stage starts from these.
     pub quality: Vec<f64>,
     /// Statistics of the run.
@@ -90,7 +90,7 @@ struct Face {
 const WEDGE_FIRST_DEG: f64 = 75.0;
 
 /// Inputs with at least this many triangles queue their interior faces by size class
-/// ([`queue::size_class`]) and oldest first within a class, rather than by exact size:
+/// (`queue::size_class`) and oldest first within a class, rather than by exact size:
 /// on a large front the exact order jumps across the whole domain at every step, while
 /// oldest first keeps consecutive steps in one neighbourhood (the 1M-tet torus's front
 /// 9.8 -> 8.6 s, the 100k one's 0.93 -> 0.84 s, with fewer relaxed steps). Smaller inputs
@@ -102,13 +102,12 @@ pub const SIZE_CLASS_MIN_TRIANGLES: usize = 8192;
 /// A candidate apex.
 #[derive(Clone, Copy)]
 struct Cand {
-    id: u32, // u32::MAX for a new point
+    /// The apex's vertex id, or [`NEW_POINT`] for a new point at `p`.
+    id: u32,
     p: P3,
     q: f64,
     dist_a: f64,
 }
-
-const NEW: u32 = u32::MAX;
 
 /// The ideal apex of one front face and the sizes it was measured with.
 struct ApexFrame {
@@ -685,7 +684,7 @@ impl<'a> Mesher<'a> {
             return false;
         };
         let f = self.faces[fid as usize];
-        let apex = if cd.id == NEW {
+        let apex = if cd.id == NEW_POINT {
             self.stats.new_vertices += 1;
             self.new_point(cd.p)
         } else {
@@ -799,7 +798,7 @@ impl<'a> Mesher<'a> {
             };
             if dmin >= min_new_dist {
                 self.cands.push(Cand {
-                    id: NEW,
+                    id: NEW_POINT,
                     p,
                     q: 0.0,
                     dist_a: 0.0,
@@ -829,18 +828,18 @@ impl<'a> Mesher<'a> {
         });
         cands.sort_by(|x, y| y.q.total_cmp(&x.q).then(x.id.cmp(&y.id)));
         if let Some(first) = cands.first() {
-            if first.id == NEW {
+            if first.id == NEW_POINT {
                 let h = fr.h;
                 let mut close: Vec<Cand> = cands
                     .iter()
-                    .filter(|c| c.id != NEW && c.dist_a < h)
+                    .filter(|c| c.id != NEW_POINT && c.dist_a < h)
                     .cloned()
                     .collect();
                 if !close.is_empty() {
                     close.sort_by(|x, y| x.dist_a.total_cmp(&y.dist_a).then(x.id.cmp(&y.id)));
                     let rest: Vec<Cand> = cands
                         .iter()
-                        .filter(|c| c.id == NEW || c.dist_a >= h)
+                        .filter(|c| c.id == NEW_POINT || c.dist_a >= h)
                         .cloned()
                         .collect();
                     close.extend(rest);
@@ -866,14 +865,14 @@ impl<'a> Mesher<'a> {
         let (prox_new, prox_old) = (r.proximity.0 * fr.target, r.proximity.1 * fr.target);
         let mut fallback = None;
         for cd in cands {
-            let apex = if cd.id == NEW {
-                validity::NEW_POINT
-            } else {
-                cd.id
-            };
+            let apex = cd.id;
             let t = [f.v[0], f.v[1], f.v[2], apex];
             let tp = [fp[0], fp[1], fp[2], cd.p];
-            let prox = if cd.id == NEW { prox_new } else { prox_old };
+            let prox = if cd.id == NEW_POINT {
+                prox_new
+            } else {
+                prox_old
+            };
             let mut bb = Aabb::of(&tp);
             for d in 0..3 {
                 bb.lo[d] -= prox;
@@ -938,7 +937,7 @@ impl<'a> Mesher<'a> {
     /// the front around both, with `t`'s new faces added, and certified P2 validity.
     fn closing_ok(&mut self, c: [u32; 4], t: [u32; 4], apex: P3) -> bool {
         let pos = |v: u32, pts: &[P3]| {
-            if v == validity::NEW_POINT {
+            if v == NEW_POINT {
                 apex
             } else {
                 pts[v as usize]

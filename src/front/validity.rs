@@ -78,8 +78,8 @@ pub struct FaceRef {
     pub boundary: bool,
 }
 
-/// Test candidate `t` (ids, with positions `tp`; t[0..3] is the base face as stored on the
-/// front, t[3] the apex) against the front faces `near` (excluding the base face).
+/// Test candidate `t` (ids, with positions `tp`; `t[0..3]` is the base face as stored on the
+/// front, `t[3]` the apex) against the front faces `near` (excluding the base face).
 /// Returns the first conflict found, if any. `min_dist` > 0 also rejects a new point (apex id
 /// [`NEW_POINT`]) that would come closer than that to an unrelated front face.
 pub fn check(

@@ -119,7 +119,7 @@ const MAX_ACTIVE: usize = 128;
 /// it is as accurate far from the origin as near it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LinearJacobian {
-    /// cols[d][j]: coefficient of l_j in column d.
+    /// `cols[d][j]`: coefficient of `l_j` in column d.
     pub cols: [[P3; 4]; 3],
     /// Largest distance |x_i - x_0| of a node from corner 0; scales the rounding margin.
     pub extent: f64,

@@ -5,10 +5,10 @@ pub mod bezier;
 pub mod distance;
 pub mod predicates;
 pub mod quadrature;
-pub mod quality;
 pub mod shape;
 #[cfg(test)]
 mod testutil;
+pub mod tet_quality;
 pub mod vec3;
 
 pub use vec3::P3;

@@ -479,7 +479,7 @@ fn tet_quality_arrays(view: &MeshView) -> Vec<[f64; 2]> {
         .par_iter()
         .map(|t| {
             let x: [P3; 10] = std::array::from_fn(|k| view.nodes[t[k] as usize]);
-            let q = crate::geom::quality::tet_quality(&x);
+            let q = crate::geom::tet_quality::tet_quality(&x);
             [q.scaled_jacobian, q.skewness]
         })
         .collect()

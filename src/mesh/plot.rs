@@ -3,7 +3,7 @@
 //! are a few dozen lines, not worth a plotting dependency.
 
 use super::report::QualityReport;
-use crate::geom::quality::Histogram;
+use crate::geom::tet_quality::Histogram;
 use std::fmt::Write;
 
 const W: f64 = 960.0;

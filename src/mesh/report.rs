@@ -6,7 +6,7 @@
 use super::TetMesh;
 use crate::geom::bezier::certify;
 use crate::geom::quadrature::{tet10_volume, CompensatedSum};
-use crate::geom::quality::{tet_quality, TetQuality, TetQualitySummary};
+use crate::geom::tet_quality::{tet_quality, TetQuality, TetQualitySummary};
 use crate::geom::P3;
 use rayon::prelude::*;
 

@@ -8,7 +8,7 @@
 //! θ at its corners; every other sliver is *unforced*: the mesher could have avoided it.
 
 use super::TetMesh;
-use crate::geom::quality::dihedral_extremes;
+use crate::geom::tet_quality::dihedral_extremes;
 use crate::geom::vec3::*;
 
 /// A tet with a dihedral angle below this many degrees is a sliver.

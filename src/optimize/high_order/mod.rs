@@ -1,11 +1,11 @@
 //! High-order node optimization of the assembled P2 mesh.
 //!
 //! Seeds are the elements whose certified min J / max J is below a threshold, worst
-//! first. Around each a patch is built ([`patch`]); patches are coloured so that those of
+//! first. Around each a patch is built (`patch`); patches are coloured so that those of
 //! one colour share no active element, and each patch is optimized once the patches of
-//! lower colours it shares an element with are done ([`schedule`]: in parallel, and the
+//! lower colours it shares an element with are done (`schedule`: in parallel, and the
 //! same result as colour by colour), by a sequence of L-BFGS runs on the log-barrier
-//! objective ([`objective`]) with the barrier moved up to just below the current minimum
+//! objective (`objective`) with the barrier moved up to just below the current minimum
 //! after each run (Gmsh's moving barrier; it starts from any state, including invalid
 //! elements), each variable measured in its node's local edge length. A patch that runs
 //! alone (the rest of its round waiting for it) has its elements evaluated by every
@@ -22,7 +22,7 @@ mod patch;
 mod schedule;
 
 use crate::geom::predicates::orient3d;
-use crate::geom::quality::{dihedral_extremes, skewness_from_extremes};
+use crate::geom::tet_quality::{dihedral_extremes, skewness_from_extremes};
 use crate::geom::vec3::{dist, mid, P3};
 use crate::mesh::report::tet_nodes;
 use crate::mesh::TetMesh;

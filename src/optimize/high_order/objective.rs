@@ -18,7 +18,7 @@
 use super::jacobian::bezier_forward;
 use super::lanes::{self, L};
 use crate::geom::bezier::scaled_jacobian_certified;
-use crate::geom::quality::DEFAULT_SJ_REL_TOL;
+use crate::geom::tet_quality::DEFAULT_SJ_REL_TOL;
 use crate::geom::vec3::{mid, P3};
 use rayon::prelude::*;
 

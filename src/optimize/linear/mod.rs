@@ -1,7 +1,7 @@
 //! Linear quality improvement of the straight-sided core, before P2 assembly.
 //!
 //! Worst element first: every tet whose quality (1 − equiangular skewness, see
-//! [`objective`]) is below the goal is attacked in turn by edge removal on its edges, 2-3
+//! `objective`) is below the goal is attacked in turn by edge removal on its edges, 2-3
 //! flips on its faces, smoothing of its interior vertices, contraction of its edges
 //! that have an interior end point, and insertion of a vertex on one of its interior
 //! edges (longest first); an operation is kept only when it raises the minimum quality

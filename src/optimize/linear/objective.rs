@@ -9,10 +9,10 @@
 use super::mesh::opposite_edge;
 use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds, LinearJacobian};
 use crate::geom::predicates::orient3d;
-use crate::geom::quality::{
+use crate::geom::shape::TET10_EDGES;
+use crate::geom::tet_quality::{
     dihedral_at_edge, dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG,
 };
-use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::P3;
 use crate::optimize::dual::{dcross, ddot, dsub, D3, DP};
 use crate::optimize::Boundary;
@@ -156,7 +156,7 @@ pub(super) fn skew_pieces(c: &[P3; 4], k: usize) -> [D3; 12] {
             }
         })
     });
-    // Outward normals of the faces opposite corners 0..3 (as in geom::quality).
+    // Outward normals of the faces opposite corners 0..3 (as in geom::tet_quality).
     let n = |a: usize, b: usize, d: usize| dcross(dsub(p[b], p[a]), dsub(p[d], p[a]));
     let normals = [n(1, 2, 3), n(0, 3, 2), n(0, 1, 3), n(0, 2, 1)];
     let te = EQUIANGULAR_DIHEDRAL_DEG;
@@ -184,7 +184,7 @@ pub(super) fn skew_pieces(c: &[P3; 4], k: usize) -> [D3; 12] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::quality::{dihedral_angles, equiangular_skewness};
+    use crate::geom::tet_quality::{dihedral_angles, equiangular_skewness};
 
     #[test]
     fn eval_above_agrees_with_eval_above_the_floor() {
