@@ -793,11 +793,12 @@ fn named_sphere(path: &Path) {
     std::fs::write(path, text).unwrap();
 }
 
-/// Issue 30: every output of a tagged-and-named input and of an untagged one, in every
-/// format and encoding, is read by meshio without warning, with a physical group for each
-/// boundary part and for the volume: the input's numbers and names (.msh: physical names;
-/// .vtu: field data as meshio keeps them), or `boundary` 1 and `volume` 1. curvetet reads
-/// the same numbers and names back, and Gmsh opens the .msh files without a warning.
+/// Issue 30: every output of a tagged-and-named input, an untagged one and a body with a
+/// cavity, in every format and encoding, is read by meshio without warning, with a
+/// physical group for each boundary part and for the volume: the input's numbers and names
+/// (.msh: physical names; .vtu: field data as meshio keeps them), or `boundary` 1 and
+/// `volume` 1. curvetet reads the same numbers and names back, and Gmsh opens the .msh
+/// files without a warning.
 #[test]
 fn groups_survive_every_output_format() {
     let named = tmp("named_sphere.msh");
@@ -820,6 +821,14 @@ fn groups_survive_every_output_format() {
         (
             "untagged",
             data("sphere_lin.off"),
+            vec![1],
+            1,
+            vec![("boundary", 1, 2), ("volume", 1, 3)],
+        ),
+        (
+            // A body with a cavity: two shells, one boundary group.
+            "cavity",
+            data("box_cavity_lin.off"),
             vec![1],
             1,
             vec![("boundary", 1, 2), ("volume", 1, 3)],
@@ -929,7 +938,7 @@ fn groups_survive_every_output_format() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(out.status.success(), "meshio failed:\n{text}");
-    assert!(text.contains("meshio ok 14"), "{text}");
+    assert!(text.contains("meshio ok 21"), "{text}");
     assert!(
         !text.to_lowercase().contains("warn"),
         "meshio warned:\n{text}"
