@@ -1103,6 +1103,8 @@ fn cli_vtu_has_quality_arrays_and_report_has_version_options_times() {
     assert_eq!(r["options"]["size"], "graded");
     assert_eq!(r["options"]["optimize"], true);
     assert_eq!(r["input"]["feature_angle"], 40.0);
+    assert_eq!(r["input"]["strict"], false);
+    assert_eq!(r["input"]["warnings"], serde_json::json!([]));
     assert!(r["input"]["path"]
         .as_str()
         .unwrap()

@@ -145,7 +145,8 @@ fn a_linear_sphere_with_a_third_of_its_facets_flipped_meshes_as_the_clean_one() 
     let (clean_out, bad_out) = (tmp("sphere_clean.msh"), tmp("sphere_flipped.msh"));
     let err = mesh(&data("sphere_lin.off"), &clean_out, &[]);
     assert!(!err.contains("warning"), "{err}");
-    let err = mesh(&bad, &bad_out, &[]);
+    let report = tmp("sphere_flipped_report.json");
+    let err = mesh(&bad, &bad_out, &["--report", s(&report)]);
     // The lowest facet is flipped, so the walk first turns the others its way, and the
     // whole shell is then found inward: net, exactly the flipped facets are turned back.
     assert!(
@@ -156,6 +157,18 @@ fn a_linear_sphere_with_a_third_of_its_facets_flipped_meshes_as_the_clean_one() 
         "{err}"
     );
     same_bytes(&clean_out, &bad_out);
+    // The report keeps what was repaired.
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(r["input"]["strict"], false);
+    let warnings = r["input"]["warnings"].as_array().unwrap();
+    assert!(
+        warnings.iter().any(|w| w
+            .as_str()
+            .unwrap()
+            .starts_with(&format!("orientation was inconsistent: flipped {n} of 708"))),
+        "{warnings:?}"
+    );
     strict_refuses(&bad, "inconsistent-orientation", true);
 
     // `curve` writes the clean surface.

@@ -675,6 +675,8 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
             "path": a.input.display().to_string(),
             "feature_angle": a.curve.feature_angle,
             "smooth": a.curve.smooth,
+            "strict": a.curve.strict,
+            "warnings": surface.warnings(),
         }),
         read_seconds: t.elapsed().as_secs_f64(),
     };
