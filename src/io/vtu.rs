@@ -499,14 +499,7 @@ impl<'a> Vtu<'a> {
     /// A field data array naming a group: kept when it holds (tag, dimension 0..3).
     fn group_name(&mut self, a: Array<'a>) -> Result<()> {
         let at = a.content_at.unwrap_or(a.at);
-        let values = if a.binary {
-            let bytes = base64_runs(a.content.trim_ascii())
-                .and_then(|b| array_bytes(&b, self.layout()))
-                .map_err(|m| self.err(at, m))?;
-            self.values(&bytes, a.ty, at)?
-        } else {
-            self.decode_ascii(&a, at)?
-        };
+        let values = self.inline_values(&a, at)?;
         if let Values::I(v) = values {
             if let [tag, dim] = v[..] {
                 if let (Ok(tag), true) = (i32::try_from(tag), (0..=3).contains(&dim)) {
@@ -533,17 +526,22 @@ impl<'a> Vtu<'a> {
             return Ok(());
         }
         let at = a.content_at.unwrap_or(a.at);
-        let values = if a.binary {
-            let bytes = base64_runs(a.content.trim_ascii())
-                .and_then(|b| array_bytes(&b, self.layout()))
-                .map_err(|m| self.err(at, m))?;
-            self.values(&bytes, a.ty, at)?
-        } else {
-            self.decode_ascii(&a, at)?
-        };
+        let values = self.inline_values(&a, at)?;
         let piece = self.piece.as_mut().expect("arrays are read inside a piece");
         store(piece, a.target, at, values);
         Ok(())
+    }
+
+    /// The values of an array held inline (base64 binary or ASCII), its content at `at`.
+    fn inline_values(&self, a: &Array<'a>, at: usize) -> Result<Values> {
+        if a.binary {
+            let bytes = base64_runs(a.content.trim_ascii())
+                .and_then(|b| array_bytes(&b, self.layout()))
+                .map_err(|m| self.err(at, m))?;
+            self.values(&bytes, a.ty, at)
+        } else {
+            self.decode_ascii(a, at)
+        }
     }
 
     fn decode_ascii(&self, a: &Array<'a>, at: usize) -> Result<Values> {
