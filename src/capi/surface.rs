@@ -338,7 +338,7 @@ pub unsafe extern "C" fn curvetet_surface_from_linear_with_flags(
     }
 }
 
-/// The body of the two `curvetet_surface_from_linear*` functions.
+/// The body of the three `curvetet_surface_from_linear*` functions.
 ///
 /// # Safety
 /// As `curvetet_surface_from_linear`.

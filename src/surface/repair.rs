@@ -172,15 +172,9 @@ pub(crate) fn drop_unused<T: Copy, const N: usize>(
 /// used by exactly two triangles (not a closed manifold surface: nothing to decide) or a
 /// shell is non-orientable. Only corners (the first three nodes) are looked at.
 pub(crate) fn consistent_flips<const N: usize>(tris: &[[u32; N]]) -> Option<Vec<bool>> {
-    // (a, b, triangle, forward) with a < b; forward: the triangle runs a -> b.
-    let mut rec: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(3 * tris.len());
-    for (t, tri) in tris.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            rec.push((a.min(b), a.max(b), t as u32, a < b));
-        }
-    }
-    rec.sort_unstable();
+    let rec = super::topology::edge_uses(tris);
+    // Does the use r run its edge from the smaller corner to the larger?
+    let forward = |r: &(u32, u32, u32, u8)| tris[r.2 as usize][r.3 as usize] == r.0;
     // Per triangle, up to three (neighbour, same direction) pairs.
     let mut adj: Vec<[(u32, bool); 3]> = vec![[(u32::MAX, false); 3]; tris.len()];
     let mut fill = vec![0u8; tris.len()];
@@ -188,7 +182,7 @@ pub(crate) fn consistent_flips<const N: usize>(tris: &[[u32; N]]) -> Option<Vec<
         let [r0, r1] = g else {
             return None;
         };
-        let same = r0.3 == r1.3;
+        let same = forward(r0) == forward(r1);
         for (r, o) in [(r0, r1), (r1, r0)] {
             let t = r.2 as usize;
             adj[t][fill[t] as usize] = (o.2, same);

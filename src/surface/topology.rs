@@ -51,19 +51,27 @@ pub(crate) struct Topology {
 
 const NONE: u32 = u32::MAX;
 
+/// Every use of a corner edge by a triangle, as (a, b, triangle, local edge k) with
+/// a < b, where the triangle's edge k runs from its corner k to corner k + 1; sorted, so
+/// the uses of one edge are adjacent. Only the first three nodes of each triangle are
+/// read (linear or 6-node triangles).
+pub(crate) fn edge_uses<const N: usize>(tris: &[[u32; N]]) -> Vec<(u32, u32, u32, u8)> {
+    let mut rec: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * tris.len());
+    for (t, tri) in tris.iter().enumerate() {
+        for k in 0..3u8 {
+            let (a, b) = (tri[k as usize], tri[(k as usize + 1) % 3]);
+            rec.push((a.min(b), a.max(b), t as u32, k));
+        }
+    }
+    rec.par_sort_unstable();
+    rec
+}
+
 impl Topology {
     /// Runs the edge, mid-node and vertex-fan checks and builds adjacency and shells.
     /// Indices must be in range and distinct within each triangle.
     pub fn build(nodes: &[P3], tris: &[[u32; 6]]) -> Result<Topology> {
-        // (a, b, triangle, local edge) with a < b.
-        let mut rec: Vec<(u32, u32, u32, u8)> = Vec::with_capacity(3 * tris.len());
-        for (t, tri) in tris.iter().enumerate() {
-            for k in 0..3u8 {
-                let (a, b) = (tri[k as usize], tri[(k as usize + 1) % 3]);
-                rec.push((a.min(b), a.max(b), t as u32, k));
-            }
-        }
-        rec.par_sort_unstable();
+        let rec = edge_uses(tris);
 
         let mut non_manifold: Option<String> = None;
         let mut open: Option<String> = None;
