@@ -153,6 +153,96 @@ pub fn icosphere(level: u32) -> (Vec<P3>, Vec<[u32; 6]>) {
     (v, tris)
 }
 
+/// Two regions: an icosphere of radius `inner` inside one of radius `outer` (both at
+/// `level`, [`icosphere`]): the inner sphere is the interface between the ball and the
+/// shell around it. The inner sphere's triangles come first, each sphere outward.
+pub fn nested_spheres(level: u32, inner: f64, outer: f64) -> (Vec<P3>, Vec<[u32; 6]>) {
+    let (v, t) = icosphere(level);
+    let n = v.len() as u32;
+    let mut nodes: Vec<P3> = v.iter().map(|p| p.map(|x| x * inner)).collect();
+    nodes.extend(v.iter().map(|p| p.map(|x| x * outer)));
+    let mut tris = t.clone();
+    tris.extend(t.iter().map(|x| x.map(|i| i + n)));
+    (nodes, tris)
+}
+
+/// Two regions: the boxes [0, 1] x [0, 1] x [0, 1] and [1, 2] x [0, 1] x [0, 1], each face
+/// split into `n` x `n` squares of two flat P2 triangles (mid nodes at edge midpoints);
+/// the shared square x = 1 appears once. Every triangle faces out of the box it was made
+/// for (the shared square: out of the first box).
+pub fn split_box(n: usize) -> (Vec<P3>, Vec<[u32; 6]>) {
+    use std::collections::HashMap;
+    let n = n.max(1);
+    // Nodes on a lattice of spacing 1 / (2n), keyed by integer coordinates.
+    let mut ids: HashMap<[i64; 3], u32> = HashMap::new();
+    let mut nodes: Vec<P3> = Vec::new();
+    let h = 1.0 / (2 * n) as f64;
+    let mut node = |k: [i64; 3]| {
+        *ids.entry(k).or_insert_with(|| {
+            nodes.push(k.map(|x| x as f64 * h));
+            nodes.len() as u32 - 1
+        })
+    };
+    let mut tris: Vec<[u32; 6]> = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    let m = 2 * n as i64;
+    for x0 in [0i64, m] {
+        // The six faces: (axis, at, outward sign).
+        for (axis, at, sign) in [
+            (0, x0, -1),
+            (0, x0 + m, 1),
+            (1, 0, -1),
+            (1, m, 1),
+            (2, 0, -1),
+            (2, m, 1),
+        ] {
+            let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+            let base = |a: i64, b: i64| {
+                let mut k = [0i64; 3];
+                k[axis] = at;
+                k[u] = a + if u == 0 { x0 } else { 0 };
+                k[w] = b + if w == 0 { x0 } else { 0 };
+                k
+            };
+            for i in 0..n as i64 {
+                for j in 0..n as i64 {
+                    let (a, b) = (2 * i, 2 * j);
+                    let c = [
+                        base(a, b),
+                        base(a + 2, b),
+                        base(a + 2, b + 2),
+                        base(a, b + 2),
+                    ];
+                    for q in [[0, 1, 2], [0, 2, 3]] {
+                        // Counterclockwise in (u, w) faces +axis.
+                        let mut k = q.map(|i| c[i]);
+                        if sign < 0 {
+                            k.swap(1, 2);
+                        }
+                        let mid = |p: [i64; 3], r: [i64; 3]| {
+                            [(p[0] + r[0]) / 2, (p[1] + r[1]) / 2, (p[2] + r[2]) / 2]
+                        };
+                        let mut key = k;
+                        key.sort_unstable();
+                        if !seen.insert(key) {
+                            continue;
+                        }
+                        tris.push([
+                            node(k[0]),
+                            node(k[1]),
+                            node(k[2]),
+                            node(mid(k[0], k[1])),
+                            node(mid(k[1], k[2])),
+                            node(mid(k[2], k[0])),
+                        ]);
+                    }
+                }
+            }
+        }
+    }
+    (nodes, tris)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

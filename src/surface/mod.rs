@@ -43,6 +43,7 @@ pub mod indices;
 pub mod intersect;
 pub mod measure;
 pub mod orientation;
+pub mod regions;
 pub mod repair;
 pub mod topology;
 
