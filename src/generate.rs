@@ -54,6 +54,9 @@ pub struct Generated {
     /// Target edge length used where the size is uniform (paper eq. 1 or the user's),
     /// or the smallest boundary size when graded.
     pub size: f64,
+    /// Per region, for a mesh of several regions ([`crate::generate_regions`]); empty
+    /// for one surface.
+    pub regions: Vec<crate::regions::RegionResult>,
 }
 
 /// The largest uniform size the boundary of `surface` supports: twice its mean corner edge
@@ -267,6 +270,7 @@ fn generate_inner(
         optimize: ostats,
         size_from: size.measured_from(),
         size: size_value,
+        regions: Vec::new(),
     })
 }
 

@@ -30,6 +30,11 @@
 //! # Ok::<(), curvetet::Error>(())
 //! ```
 //!
+//! A surface bounding several regions (materials sharing interfaces, as Gmsh physical
+//! volumes) is meshed into one conforming mesh with a region id per tet by
+//! [`generate_regions`]; [`MeshInput`] reads either kind from a file and
+//! [`generate_input`] meshes it (what the command-line tool and the C ABI do).
+//!
 //! The command-line tool (`curvetet`, cargo feature `cli`, on by default) and the C ABI
 //! (`include/curvetet.h`) are built on the same functions.
 
@@ -37,6 +42,7 @@ pub mod io;
 
 mod error;
 mod options;
+mod regions;
 
 // The modules below are public only for this repository's command-line tool, tests,
 // benchmarks and examples (and the C ABI's symbols): not part of the library's API, hidden
@@ -74,6 +80,9 @@ pub use mesh::slivers::SliverCensus;
 pub use mesh::TetMesh;
 pub use optimize::{HighOrderStats, LinearStats, OptimizeStats};
 pub use options::{Options, SizeFrom, SizeMode};
+pub use regions::{
+    generate_input, generate_regions, MeshInput, Region, RegionMode, RegionResult, Regions,
+};
 pub use surface::curve::{CurveOptions, MidpointRule, NormalWeights};
 pub use surface::{Repair, Surface};
 

@@ -128,6 +128,7 @@ fn curved_mesh() -> TetMesh {
         boundary,
         boundary_tags: vec![4, 7, 4, 2, 7, 9],
         groups: Default::default(),
+        tet_regions: Vec::new(),
     }
 }
 

@@ -97,6 +97,7 @@ fn small_mesh() -> TetMesh {
         ],
         boundary_tags: vec![1, 2, 3, 3],
         groups: Default::default(),
+        tet_regions: Vec::new(),
     }
 }
 
@@ -116,6 +117,7 @@ fn written_files() -> Vec<(String, Format, Vec<u8>, usize)> {
         boundary: s.tri6,
         boundary_tags: s.tri6_tags,
         groups: Default::default(),
+        tet_regions: Vec::new(),
     };
     let mut out = Vec::new();
     for (mname, m) in [("tet", &mesh), ("sphere", &big)] {

@@ -84,6 +84,7 @@ fn grid_mesh(n: usize) -> TetMesh {
         boundary,
         boundary_tags,
         groups: Default::default(),
+        tet_regions: Vec::new(),
     }
 }
 

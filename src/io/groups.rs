@@ -17,6 +17,8 @@ use super::VOLUME_TAG;
 pub const UNTAGGED_BOUNDARY_NAME: &str = "boundary";
 /// The name of the volume group when the input does not name it.
 pub const DEFAULT_VOLUME_NAME: &str = "volume";
+/// Unnamed regions of a mesh of several regions are named this followed by their id.
+pub const REGION_NAME_PREFIX: &str = "region_";
 
 /// A named physical group, as in Gmsh's `$PhysicalNames`: dimension (2 surface, 3 volume),
 /// tag, name.
@@ -66,13 +68,17 @@ pub(crate) struct Resolved {
     pub surface: BTreeMap<i32, i32>,
     /// The volume's physical tag (positive).
     pub volume: i32,
+    /// The volume groups written: `[volume]`, or the region ids of a mesh of several
+    /// regions (ascending).
+    pub volumes: Vec<i32>,
     /// Names of the groups written, sorted by (dim, tag).
     pub names: Vec<PhysicalName>,
 }
 
 impl Resolved {
-    /// The groups of a mesh with triangle tags `tags`, with a volume if `has_volume`.
-    pub fn new(tags: &[i32], groups: &Groups, has_volume: bool) -> Resolved {
+    /// The groups of a mesh with triangle tags `tags`, with a volume if `has_volume`,
+    /// and region ids `regions` per tet (empty: one volume).
+    pub fn new(tags: &[i32], groups: &Groups, has_volume: bool, regions: &[i32]) -> Resolved {
         let distinct: BTreeSet<i32> = tags.iter().copied().collect();
         let mut surface = BTreeMap::new();
         let mut used: BTreeSet<i32> = distinct.iter().copied().filter(|&t| t > 0).collect();
@@ -116,16 +122,35 @@ impl Resolved {
                 });
             }
         }
-        if has_volume {
-            names.insert(PhysicalName {
-                dim: 3,
-                tag: volume,
-                name: clean(groups.name(3, volume).unwrap_or(DEFAULT_VOLUME_NAME)),
-            });
+        let mut volumes: Vec<i32> = regions.to_vec();
+        volumes.sort_unstable();
+        volumes.dedup();
+        if volumes.is_empty() {
+            volumes.push(volume);
+            if has_volume {
+                names.insert(PhysicalName {
+                    dim: 3,
+                    tag: volume,
+                    name: clean(groups.name(3, volume).unwrap_or(DEFAULT_VOLUME_NAME)),
+                });
+            }
+        } else {
+            for &r in &volumes {
+                let name = groups
+                    .name(3, r)
+                    .map(clean)
+                    .unwrap_or_else(|| format!("{REGION_NAME_PREFIX}{r}"));
+                names.insert(PhysicalName {
+                    dim: 3,
+                    tag: r,
+                    name,
+                });
+            }
         }
         Resolved {
             surface,
-            volume,
+            volume: volumes[0],
+            volumes,
             names: names.into_iter().collect(),
         }
     }
@@ -152,8 +177,32 @@ mod tests {
     use super::*;
 
     #[test]
+    fn regions_are_volume_groups_named_by_the_input_or_by_id() {
+        let g = Groups {
+            volume_tag: 1,
+            names: vec![PhysicalName {
+                dim: 3,
+                tag: 7,
+                name: "blood".into(),
+            }],
+        };
+        let r = Resolved::new(&[0, 0], &g, true, &[7, 2, 7]);
+        assert_eq!(r.volumes, vec![2, 7]);
+        assert_eq!(r.volume, 2);
+        let names: Vec<_> = r
+            .names
+            .iter()
+            .map(|n| (n.dim, n.tag, n.name.as_str()))
+            .collect();
+        assert_eq!(
+            names,
+            vec![(2, 1, "boundary"), (3, 2, "region_2"), (3, 7, "blood")]
+        );
+    }
+
+    #[test]
     fn untagged_becomes_boundary_one_and_volume_is_named() {
-        let r = Resolved::new(&[0, 0, 0], &Groups::default(), true);
+        let r = Resolved::new(&[0, 0, 0], &Groups::default(), true, &[]);
         assert_eq!(r.surface[&0], 1);
         assert_eq!(r.volume, VOLUME_TAG);
         let names: Vec<_> = r
@@ -181,7 +230,7 @@ mod tests {
                 },
             ],
         };
-        let r = Resolved::new(&[1, 3, 0, -2, 3], &g, true);
+        let r = Resolved::new(&[1, 3, 0, -2, 3], &g, true, &[]);
         assert_eq!(r.triangle_tags(&[1, 3, 0, -2]), vec![1, 3, 2, 4]);
         assert_eq!(r.volume, 4);
         let names: Vec<_> = r

@@ -57,9 +57,10 @@ pub(crate) fn write<W: Write>(
         })?;
         uint(w, view.tet10.len() as u64)?;
         w.write_all(b"\n")?;
-        for t in view.tet10 {
+        for (i, t) in view.tet10.iter().enumerate() {
             let t = order::tet10_to(Convention::Medit, t);
-            record(w, if linear { &t[..4] } else { &t }, volume_tag)?;
+            let tag = view.tet_regions.get(i).copied().unwrap_or(volume_tag);
+            record(w, if linear { &t[..4] } else { &t }, tag)?;
         }
     }
     w.write_all(b"\nEnd\n")

@@ -39,6 +39,11 @@
 //!   cells; use a Threshold on the cell type or the tag to see one or the other); a
 //!   `.vtu` names the groups in field data arrays (name -> (number, dimension)), read back
 //!   into [`RawMesh::physical_names`].
+//! - A mesh of several regions ([`TetMesh::tet_regions`]): each region is a volume group
+//!   numbered by its id and named as the input named it, else `region_ID`; in `.msh` one
+//!   volume entity per region, in `.vtu`/`.vtk` each tetrahedron's `BoundaryTag` holds its
+//!   region id (instead of 0), in `.mesh` its reference. The interface triangles between
+//!   two regions are boundary triangles like the others, listed once.
 //! - `.mesh`: `Vertices` (reference 0), `TrianglesP2` with reference = group number, and
 //!   `TetrahedraP2` with the volume's number, in the order established in [`order`];
 //!   with [`WriteOptions::medit_linear`], `Triangles` and `Tetrahedra` on the corner nodes
@@ -75,7 +80,9 @@ mod vtu_write;
 mod weld;
 
 pub use atomic::{check_output_dir, remove_unfinished_temporaries, same_file, write_atomic};
-pub use groups::{Groups, PhysicalName, DEFAULT_VOLUME_NAME, UNTAGGED_BOUNDARY_NAME};
+pub use groups::{
+    Groups, PhysicalName, DEFAULT_VOLUME_NAME, REGION_NAME_PREFIX, UNTAGGED_BOUNDARY_NAME,
+};
 pub use surface::{
     read_any_surface, read_surface, surface_from_raw, surface_from_raw_any,
     surface_from_raw_with_repair,
@@ -141,6 +148,8 @@ impl RawMesh {
     }
 
     /// The P2 mesh in it: nodes, 10-node tets and 6-node boundary triangles with tags.
+    /// Tets with several distinct positive tags are a mesh of several regions: their tags
+    /// become [`TetMesh::tet_regions`].
     ///
     /// A file with only 3-node triangles is a linear surface:
     /// `Error::InvalidSurface(LinearSurface)`; 4-node tets without 10-node ones likewise
@@ -162,12 +171,20 @@ impl RawMesh {
             )));
         }
         let groups = self.groups();
+        let tet_regions = if self.tet10_tags.iter().all(|&t| t > 0)
+            && self.tet10_tags.iter().any(|&t| t != self.tet10_tags[0])
+        {
+            self.tet10_tags
+        } else {
+            Vec::new()
+        };
         Ok(TetMesh {
             nodes: self.nodes,
             tets: self.tet10,
             boundary: self.tri6,
             boundary_tags: self.tri6_tags,
             groups,
+            tet_regions,
         })
     }
 }
@@ -402,6 +419,8 @@ pub(crate) struct MeshView<'a> {
     pub tags: &'a [i32],
     pub tet10: &'a [[u32; 10]],
     pub groups: &'a Groups,
+    /// Region id per tet (positive), or empty for one volume.
+    pub tet_regions: &'a [i32],
 }
 
 impl MeshView<'_> {
@@ -424,6 +443,19 @@ impl MeshView<'_> {
                 )));
             }
         }
+        if !self.tet_regions.is_empty() && self.tet_regions.len() != self.tet10.len() {
+            return Err(Error::InvalidArgument(format!(
+                "{} tetrahedra but {} region ids",
+                self.tet10.len(),
+                self.tet_regions.len()
+            )));
+        }
+        if let Some(i) = self.tet_regions.iter().position(|&r| r <= 0) {
+            return Err(Error::InvalidArgument(format!(
+                "tetrahedron {i} has region id {}; region ids must be positive",
+                self.tet_regions[i]
+            )));
+        }
         for (i, t) in self.tet10.iter().enumerate() {
             if let Some(&v) = t.iter().find(|&&v| v as usize >= n) {
                 return Err(Error::InvalidArgument(format!(
@@ -444,7 +476,7 @@ fn write_view<W: Write>(
     // .msh writes the groups itself (entities, names); the others write each triangle's
     // physical tag (untagged triangles: the `boundary` group's number, not 0).
     let has_volume = !view.tet10.is_empty() || view.tri6.is_empty();
-    let groups = groups::Resolved::new(view.tags, view.groups, has_volume);
+    let groups = groups::Resolved::new(view.tags, view.groups, has_volume, view.tet_regions);
     let tags = if format == Format::Msh {
         Vec::new()
     } else {
@@ -481,6 +513,27 @@ fn tet_quality_arrays(view: &MeshView) -> Vec<[f64; 2]> {
             let x: [P3; 10] = std::array::from_fn(|k| view.nodes[t[k] as usize]);
             let q = crate::geom::tet_quality::tet_quality(&x);
             [q.scaled_jacobian, q.skewness]
+        })
+        .collect()
+}
+
+/// The id and name of each region of a mesh of several regions, as the writers name
+/// them (the input's name for that volume, else `region_ID`); empty for one region.
+pub fn region_names(mesh: &TetMesh) -> Vec<(i32, String)> {
+    if mesh.tet_regions.is_empty() {
+        return Vec::new();
+    }
+    let r = groups::Resolved::new(&mesh.boundary_tags, &mesh.groups, true, &mesh.tet_regions);
+    r.volumes
+        .iter()
+        .map(|&v| {
+            let name = r
+                .names
+                .iter()
+                .find(|n| n.dim == 3 && n.tag == v)
+                .map(|n| n.name.clone())
+                .unwrap_or_default();
+            (v, name)
         })
         .collect()
 }
@@ -531,6 +584,7 @@ pub fn write_mesh(path: &Path, mesh: &TetMesh, opts: &WriteOptions) -> Result<()
         tags: &mesh.boundary_tags,
         tet10: &mesh.tets,
         groups: &mesh.groups,
+        tet_regions: &mesh.tet_regions,
     };
     write_file(path, &view, opts)
 }
@@ -550,6 +604,7 @@ pub fn write_surface(
         tags,
         tet10: &[],
         groups: &Groups::default(),
+        tet_regions: &[],
     };
     write_file(path, &view, opts)
 }
@@ -562,6 +617,7 @@ pub fn mesh_to_bytes(mesh: &TetMesh, format: Format, opts: &WriteOptions) -> Res
         tags: &mesh.boundary_tags,
         tet10: &mesh.tets,
         groups: &mesh.groups,
+        tet_regions: &mesh.tet_regions,
     };
     check_options(format, opts, &view)?;
     view.validate()?;

@@ -2,7 +2,8 @@
 //!
 //! Layout (see `io` module docs): one surface entity per distinct boundary tag, in its own
 //! physical group (the tag itself when positive, else a free number); one volume entity in
-//! the volume's physical group; `$PhysicalNames` for the named groups (see
+//! the volume's physical group (with several regions, one volume entity per region, its
+//! tag and physical group the region id); `$PhysicalNames` for the named groups (see
 //! [`Resolved`]). Node and element order are kept: node `i` has tag `i + 1`, and 4.1
 //! element blocks follow runs of equal tags in the triangle list, so a file read back
 //! gives the same indices.
@@ -27,17 +28,36 @@ struct Entities {
     /// Each triangle's entity (= physical) tag.
     tri_entity: Vec<i32>,
     has_volume: bool,
+    /// The volume entities as (entity tag, physical tag): one, or one per region.
+    volumes: Vec<(i32, i32)>,
+    /// Each tet's volume entity tag.
+    tet_entity: Vec<i32>,
 }
 
 impl Entities {
     fn new(view: &MeshView) -> Entities {
         let has_volume = !view.tet10.is_empty() || view.tri6.is_empty();
-        let groups = Resolved::new(view.tags, view.groups, has_volume);
+        let groups = Resolved::new(view.tags, view.groups, has_volume, view.tet_regions);
         let tri_entity = groups.triangle_tags(view.tags);
+        // One region: entity VOLUME_ENTITY in the volume's group; several: each region
+        // is its own entity and group, both numbered by its id.
+        let (volumes, tet_entity) = if view.tet_regions.is_empty() {
+            (
+                vec![(VOLUME_ENTITY, groups.volume)],
+                vec![VOLUME_ENTITY; view.tet10.len()],
+            )
+        } else {
+            (
+                groups.volumes.iter().map(|&r| (r, r)).collect(),
+                view.tet_regions.to_vec(),
+            )
+        };
         Entities {
             groups,
             tri_entity,
             has_volume,
+            volumes,
+            tet_entity,
         }
     }
 
@@ -48,11 +68,12 @@ impl Entities {
         s
     }
 
-    /// Each node's entity (dim, tag): the first triangle using it, else the volume (or,
+    /// Each node's entity (dim, tag): the first triangle using it, else (with several
+    /// regions) the region of the first tet using it, else the (first) volume (or,
     /// without a volume, the first surface).
     fn node_entities(&self, view: &MeshView) -> Vec<(i32, i32)> {
         let fallback = if self.has_volume {
-            (3, VOLUME_ENTITY)
+            (3, self.volumes[0].0)
         } else {
             (2, self.tri_entity[0])
         };
@@ -64,6 +85,15 @@ impl Entities {
                 }
             }
         }
+        if !view.tet_regions.is_empty() {
+            for (t, &ent) in view.tet10.iter().zip(&self.tet_entity) {
+                for &v in t {
+                    if e[v as usize].0 == 0 {
+                        e[v as usize] = (3, ent);
+                    }
+                }
+            }
+        }
         for x in e.iter_mut() {
             if x.0 == 0 {
                 *x = fallback;
@@ -72,8 +102,8 @@ impl Entities {
         e
     }
 
-    /// Bounding boxes of the surface entities (by entity tag) and of the volume.
-    fn bboxes(&self, view: &MeshView) -> (BTreeMap<i32, [f64; 6]>, [f64; 6]) {
+    /// Bounding boxes of the surface entities and of the volume entities (by entity tag).
+    fn bboxes(&self, view: &MeshView) -> (BTreeMap<i32, [f64; 6]>, BTreeMap<i32, [f64; 6]>) {
         const EMPTY: [f64; 6] = [
             f64::INFINITY,
             f64::INFINITY,
@@ -101,6 +131,17 @@ impl Entities {
             }
         }
         surf.values_mut().for_each(finish);
+        if !view.tet_regions.is_empty() {
+            let mut vols: BTreeMap<i32, [f64; 6]> = BTreeMap::new();
+            for (t, &e) in view.tet10.iter().zip(&self.tet_entity) {
+                let b = vols.entry(e).or_insert(EMPTY);
+                for &v in t {
+                    grow(b, &view.nodes[v as usize]);
+                }
+            }
+            vols.values_mut().for_each(finish);
+            return (surf, vols);
+        }
         // The nodes the tets use, marked and then swept in order: the same box as growing
         // it through the tets' nodes, without a random read of the node array for each.
         let mut used = vec![false; view.nodes.len()];
@@ -114,7 +155,7 @@ impl Entities {
             grow(&mut vol, p);
         }
         finish(&mut vol);
-        (surf, vol)
+        (surf, BTreeMap::from([(VOLUME_ENTITY, vol)]))
     }
 }
 
@@ -229,7 +270,12 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
     o.size(0, b" ")?;
     let surfaces = ents.surfaces();
     o.size(surfaces.len() as u64, b" ")?;
-    o.size(ents.has_volume as u64, b"\n")?;
+    let nvol = if ents.has_volume {
+        ents.volumes.len()
+    } else {
+        0
+    };
+    o.size(nvol as u64, b"\n")?;
     let (surf_box, vol_box) = ents.bboxes(view);
     for &etag in &surfaces {
         let b = surf_box.get(&etag).copied().unwrap_or([0.0; 6]);
@@ -241,13 +287,13 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
         o.int(etag, b" ")?;
         o.size(0, b"\n")?;
     }
-    if ents.has_volume {
-        o.int(VOLUME_ENTITY, b" ")?;
-        for x in vol_box {
+    for &(etag, phys) in &ents.volumes[..nvol] {
+        o.int(etag, b" ")?;
+        for x in vol_box.get(&etag).copied().unwrap_or([0.0; 6]) {
             o.double(x, b" ")?;
         }
         o.size(1, b" ")?;
-        o.int(ents.groups.volume, b" ")?;
+        o.int(phys, b" ")?;
         o.size(surfaces.len() as u64, b"")?;
         for &etag in &surfaces {
             if !o.binary {
@@ -295,7 +341,8 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
 
     // $Elements: triangle blocks per run of equal entity, then the tets.
     let tri_runs = runs(&ents.tri_entity);
-    let nblocks = tri_runs.len() + usize::from(!view.tet10.is_empty());
+    let tet_runs = runs(&ents.tet_entity);
+    let nblocks = tri_runs.len() + tet_runs.len();
     let m = (view.tri6.len() + view.tet10.len()) as u64;
     o.raw(b"$Elements\n")?;
     o.size(nblocks as u64, b" ")?;
@@ -317,12 +364,12 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
             }
         }
     }
-    if !view.tet10.is_empty() {
+    for &(s, e, etag) in &tet_runs {
         o.int(3, b" ")?;
-        o.int(VOLUME_ENTITY, b" ")?;
+        o.int(etag, b" ")?;
         o.int(TET10, b" ")?;
-        o.size(view.tet10.len() as u64, b"\n")?;
-        for t in view.tet10 {
+        o.size((e - s) as u64, b"\n")?;
+        for t in &view.tet10[s..e] {
             o.size(tag, b" ")?;
             tag += 1;
             let t = order::tet10_to(Convention::Gmsh, t);
@@ -386,14 +433,19 @@ fn write22<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
         o.int(view.tet10.len() as i32, b"")?;
         o.int(2, b"")?;
     }
-    for t in view.tet10 {
+    for (t, &etag) in view.tet10.iter().zip(&ents.tet_entity) {
         o.int(id, b" ")?;
         id += 1;
         if !o.binary {
             o.raw(b"11 2 ")?;
         }
-        o.int(ents.groups.volume, b" ")?;
-        o.int(VOLUME_ENTITY, b" ")?;
+        let phys = if view.tet_regions.is_empty() {
+            ents.groups.volume
+        } else {
+            etag
+        };
+        o.int(phys, b" ")?;
+        o.int(etag, b" ")?;
         let t = order::tet10_to(Convention::Gmsh, t);
         for (k, &v) in t.iter().enumerate() {
             o.int(v as i32 + 1, if k == 9 { b"\n" } else { b" " })?;

@@ -115,13 +115,13 @@ impl Cell {
 }
 
 /// The cells a writer emits, in order: the tetrahedra, then the boundary triangles.
-/// Tetrahedra get tag 0.
+/// Tetrahedra get tag 0, or their region id in a mesh of several regions.
 pub(crate) fn cells<'a>(view: &'a MeshView) -> impl Iterator<Item = Cell> + 'a {
-    let tets = view.tet10.iter().map(|t| Cell {
+    let tets = view.tet10.iter().enumerate().map(|(i, t)| Cell {
         ty: QUADRATIC_TETRA,
         nodes: order::tet10_to(Convention::Vtk, t),
         len: 10,
-        tag: 0,
+        tag: view.tet_regions.get(i).copied().unwrap_or(0),
     });
     let tris = view.tri6.iter().zip(view.tags).map(|(t, &g)| {
         let mut nodes = [0u32; 10];

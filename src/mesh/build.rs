@@ -97,5 +97,6 @@ pub fn assemble(
         boundary: surf_tris.to_vec(),
         boundary_tags: tags,
         groups: Default::default(),
+        tet_regions: Vec::new(),
     }
 }

@@ -21,10 +21,27 @@ pub struct TetMesh {
     /// The volume's physical tag and the group names the writers use (from the input
     /// surface's file; see [`crate::io::Groups`]).
     pub groups: crate::io::Groups,
+    /// The region (physical volume) of each tet, for a mesh of several regions (see
+    /// [`crate::generate_regions`]); empty when every tet is in the one volume
+    /// `groups.volume_tag`. Region ids are positive; the writers put each region in its
+    /// own physical group, and [`TetMesh::boundary`] then also holds the interface
+    /// triangles between two regions (once each).
+    pub tet_regions: Vec<i32>,
+}
+
+impl TetMesh {
+    /// The distinct region ids, ascending (empty for a one-region mesh).
+    pub fn region_ids(&self) -> Vec<i32> {
+        let mut r = self.tet_regions.clone();
+        r.sort_unstable();
+        r.dedup();
+        r
+    }
 }
 
 pub mod build;
 pub mod check;
+pub mod merge;
 pub mod plot;
 pub mod report;
 pub mod slivers;

@@ -103,6 +103,7 @@ mod tests {
                 .collect(),
             boundary_tags: Vec::new(),
             groups: Default::default(),
+            tet_regions: Vec::new(),
         }
     }
 
