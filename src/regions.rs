@@ -39,7 +39,8 @@ use crate::{Error, Options, Repair, Result, Surface};
 #[non_exhaustive]
 pub enum RegionMode {
     /// Several regions when some edge has more than two triangles (a junction of
-    /// regions); otherwise one surface, nested shells being cavities.
+    /// regions) and two regions share triangles (an interface); otherwise one surface,
+    /// nested shells being cavities.
     #[default]
     Auto,
     /// Every bounded region of space the triangles enclose is a region to mesh: a shell
@@ -278,27 +279,7 @@ impl MeshInput {
         mode: RegionMode,
     ) -> Result<MeshInput> {
         let linear = raw.tri6.is_empty() && !raw.tri3.is_empty();
-        let several = if raw.tet4.is_empty() && raw.tet10.is_empty() {
-            let junctions = if linear {
-                has_junction_edges(&raw.tri3)
-            } else {
-                has_junction_edges(&raw.tri6)
-            };
-            junctions
-                || (mode == RegionMode::EveryShell && {
-                    let nodes: &[P3] = &raw.nodes;
-                    let split = if linear {
-                        split_regions(nodes, &raw.tri3)
-                    } else {
-                        split_regions(nodes, &raw.tri6)
-                    };
-                    // Errors are left to the single-surface checks, which name them.
-                    split.map(|s| s.len() > 1).unwrap_or(false)
-                })
-        } else {
-            false
-        };
-        if !several {
+        if !MeshInput::several_regions(&raw, mode) {
             return crate::io::surface_from_raw_any(raw, name, curve).map(MeshInput::Surface);
         }
         let groups = raw.groups();
@@ -309,6 +290,47 @@ impl MeshInput {
         }
         .map_err(|e| named(e, name))?;
         Ok(MeshInput::Regions(regions.with_groups(groups)))
+    }
+
+    /// Do the triangles of `raw` (6-node, else 3-node) bound several regions under
+    /// `mode`? [`RegionMode::Auto`]: some edge has more than two triangles and the
+    /// triangles split into regions of which two share a triangle (an interface; bodies
+    /// merely touching along an edge are not regions, and a surface that does not split
+    /// is left to the single-surface checks, which name its defect).
+    /// [`RegionMode::EveryShell`]: the triangles split into more than one region. A
+    /// volume mesh's file never does (its boundary is one surface).
+    pub fn several_regions(raw: &RawMesh, mode: RegionMode) -> bool {
+        if !raw.tet4.is_empty() || !raw.tet10.is_empty() {
+            return false;
+        }
+        let linear = raw.tri6.is_empty() && !raw.tri3.is_empty();
+        let junctions = if linear {
+            has_junction_edges(&raw.tri3)
+        } else {
+            has_junction_edges(&raw.tri6)
+        };
+        if !junctions && mode == RegionMode::Auto {
+            return false;
+        }
+        let split = if linear {
+            split_regions(&raw.nodes, &raw.tri3)
+        } else {
+            split_regions(&raw.nodes, &raw.tri6)
+        };
+        let Ok(split) = split else {
+            return false;
+        };
+        match mode {
+            RegionMode::EveryShell => split.len() > 1,
+            RegionMode::Auto => {
+                let mut seen = vec![false; raw.tri3.len().max(raw.tri6.len())];
+                split.iter().flat_map(|r| &r.triangles).any(|&t| {
+                    let again = seen[t as usize];
+                    seen[t as usize] = true;
+                    again
+                })
+            }
+        }
     }
 
     /// [`MeshInput::from_raw`] on the file `path`.
@@ -330,6 +352,19 @@ impl MeshInput {
         match self {
             MeshInput::Surface(s) => s.warnings(),
             MeshInput::Regions(r) => r.warnings(),
+        }
+    }
+
+    /// [`crate::estimated_peak_memory`] of the surface, or the sum over the regions
+    /// (they are meshed one after the other, but the merged mesh holds them all).
+    pub fn estimated_peak_memory(&self, opts: &Options) -> u64 {
+        match self {
+            MeshInput::Surface(s) => crate::generate::estimated_peak_memory(s, opts),
+            MeshInput::Regions(r) => r
+                .regions
+                .iter()
+                .map(|x| crate::generate::estimated_peak_memory(&x.surface, opts))
+                .fold(0u64, u64::saturating_add),
         }
     }
 

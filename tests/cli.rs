@@ -764,6 +764,111 @@ for f in spec:
 print("meshio ok", len(spec))
 "#;
 
+/// The linear surface of [`curvetet::surface::demo::split_box`] (two unit boxes sharing
+/// the wall x = 1, given once) as an OFF file.
+fn split_box_off(path: &Path, n: usize) {
+    use std::collections::HashMap;
+    use std::fmt::Write;
+    let (nodes, tris) = curvetet::surface::demo::split_box(n);
+    let mut ids = HashMap::new();
+    let mut corners = Vec::new();
+    let faces: Vec<[u32; 3]> = tris
+        .iter()
+        .map(|t| {
+            [0, 1, 2].map(|k| {
+                *ids.entry(t[k]).or_insert_with(|| {
+                    corners.push(nodes[t[k] as usize]);
+                    corners.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    let mut text = format!("OFF\n{} {} 0\n", corners.len(), faces.len());
+    for p in &corners {
+        writeln!(text, "{} {} {}", p[0], p[1], p[2]).unwrap();
+    }
+    for f in &faces {
+        writeln!(text, "3 {} {} {}", f[0], f[1], f[2]).unwrap();
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// Issue 30: a surface of two regions meshes through `curvetet mesh` into one conforming
+/// mesh that `check` accepts and reports by region: a box split by a wall (found by its
+/// junction edges) and a sphere inside a sphere (P2, `--nested-regions`); `check` on the
+/// inputs reports their regions.
+#[test]
+fn mesh_and_check_two_region_surfaces() {
+    let boxes = tmp("regions_box.off");
+    split_box_off(&boxes, 2);
+    let spheres = tmp("regions_spheres.msh");
+    let (nodes, tris) = curvetet::surface::demo::nested_spheres(1, 0.5, 1.0);
+    let ntris = tris.len();
+    curvetet::io::write_surface(
+        &spheres,
+        &nodes,
+        &tris,
+        &vec![0; ntris],
+        &Default::default(),
+    )
+    .unwrap();
+    for (input, flags, interfaces) in [
+        (&boxes, &[][..], 8),
+        (&spheres, &["--nested-regions"][..], ntris / 2),
+    ] {
+        let mut args = vec!["check", input.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let out = run(&args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(out.status.success(), "{text}");
+        assert!(text.contains("valid surface of 2 regions"), "{text}");
+        let msh = tmp(&format!(
+            "{}_out.msh",
+            input.file_stem().unwrap().to_str().unwrap()
+        ));
+        let mut args = vec![
+            "mesh",
+            input.to_str().unwrap(),
+            "-o",
+            msh.to_str().unwrap(),
+            "--threads",
+            "1",
+        ];
+        args.extend_from_slice(flags);
+        let out = run(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{err}");
+        assert!(err.contains("2 regions: meshing each"), "{err}");
+        let out = run(&["check", msh.to_str().unwrap(), "--json"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let j: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(j["valid"], true);
+        assert_eq!(j["conformity"]["interface_faces"], interfaces);
+        let regions = j["regions"].as_array().unwrap();
+        let got: Vec<(i64, &str)> = regions
+            .iter()
+            .map(|r| (r["tag"].as_i64().unwrap(), r["name"].as_str().unwrap()))
+            .collect();
+        assert_eq!(got, vec![(1, "region_1"), (2, "region_2")]);
+        assert!(regions.iter().all(|r| r["tets"].as_u64().unwrap() > 0));
+    }
+    // Without --nested-regions, the inner sphere is a cavity: one region.
+    let msh = tmp("regions_cavity_out.msh");
+    let out = run(&[
+        "mesh",
+        spheres.to_str().unwrap(),
+        "-o",
+        msh.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let raw = curvetet::io::read(&msh).unwrap();
+    assert!(raw.tet10_tags.iter().all(|&t| t == 1));
+}
+
 /// A P2 sphere whose triangles are tagged 3 (z > 0, "inlet") and 7 ("wall"), in a
 /// volume named "fluid" with tag 4: an MSH 2.2 file as Gmsh writes one with named
 /// physical groups.
@@ -793,8 +898,8 @@ fn named_sphere(path: &Path) {
     std::fs::write(path, text).unwrap();
 }
 
-/// Issue 30: every output of a tagged-and-named input, an untagged one and a body with a
-/// cavity, in every format and encoding, is read by meshio without warning, with a
+/// Issue 30: every output of a tagged-and-named input, an untagged one, a body with a
+/// cavity and two regions with an interface, in every format and encoding, is read by meshio without warning, with a
 /// physical group for each boundary part and for the volume: the input's numbers and names
 /// (.msh: physical names; .vtu: field data as meshio keeps them), or `boundary` 1 and
 /// `volume` 1. curvetet reads the same numbers and names back, and Gmsh opens the .msh
@@ -803,11 +908,14 @@ fn named_sphere(path: &Path) {
 fn groups_survive_every_output_format() {
     let named = tmp("named_sphere.msh");
     named_sphere(&named);
+    let regions = tmp("groups_split_box.off");
+    split_box_off(&regions, 2);
+    // (name, input, triangle groups, volume groups, names)
     type Case = (
         &'static str,
         PathBuf,
         Vec<i32>,
-        i32,
+        Vec<i32>,
         Vec<(&'static str, i32, u8)>,
     );
     let cases: Vec<Case> = vec![
@@ -815,14 +923,14 @@ fn groups_survive_every_output_format() {
             "named",
             named,
             vec![3, 7],
-            4,
+            vec![4],
             vec![("inlet", 3, 2), ("wall", 7, 2), ("fluid", 4, 3)],
         ),
         (
             "untagged",
             data("sphere_lin.off"),
             vec![1],
-            1,
+            vec![1],
             vec![("boundary", 1, 2), ("volume", 1, 3)],
         ),
         (
@@ -830,13 +938,26 @@ fn groups_survive_every_output_format() {
             "cavity",
             data("box_cavity_lin.off"),
             vec![1],
-            1,
+            vec![1],
             vec![("boundary", 1, 2), ("volume", 1, 3)],
+        ),
+        (
+            // Two regions with an interface: two boxes sharing a wall.
+            "regions",
+            regions,
+            vec![1, 2],
+            vec![1, 2],
+            vec![
+                ("boundary", 1, 2),
+                ("interface_1_2", 2, 2),
+                ("region_1", 1, 3),
+                ("region_2", 2, 3),
+            ],
         ),
     ];
     let gmsh = Command::new("gmsh").arg("-version").output().is_ok();
     let mut spec = Vec::new();
-    for (name, input, tri, vol, names) in &cases {
+    for (name, input, tri, vols, names) in &cases {
         let first = tmp(&format!("groups_{name}.msh"));
         let out = run(&[
             "mesh",
@@ -878,7 +999,7 @@ fn groups_survive_every_output_format() {
             got.dedup();
             assert_eq!(&got, tri, "{name} {suffix}");
             if named {
-                assert_eq!(back.groups().volume_tag, *vol, "{name} {suffix}");
+                assert_eq!(back.groups().volume_tag, vols[0], "{name} {suffix}");
                 let mut got: Vec<(String, i32, u8)> = back
                     .physical_names
                     .iter()
@@ -892,28 +1013,35 @@ fn groups_survive_every_output_format() {
                 want.sort();
                 assert_eq!(got, want, "{name} {suffix}");
             }
-            if msh {
-                assert!(back.tet10_tags.iter().all(|t| t == vol), "{name} {suffix}");
-                if gmsh {
-                    let o = Command::new("gmsh")
-                        .args([path.to_str().unwrap(), "-0", "-o"])
-                        .arg(tmp(&format!("groups_{name}_{suffix}_gmsh.msh")))
-                        .output()
-                        .unwrap();
-                    let text = String::from_utf8_lossy(&o.stdout).to_string()
-                        + &String::from_utf8_lossy(&o.stderr);
-                    assert!(o.status.success(), "gmsh {name} {suffix}: {text}");
-                    assert!(
-                        !text.contains("Warning") && !text.contains("Error"),
-                        "gmsh {name} {suffix}: {text}"
-                    );
-                }
+            // Each tet is in its region (in .vtu/.vtk: the tets' tag, 0 for one region).
+            let mut tets: Vec<i32> = back.tet10_tags.clone();
+            tets.sort_unstable();
+            tets.dedup();
+            let tet_tags = if msh || vols.len() > 1 {
+                vols.clone()
+            } else {
+                vec![0]
+            };
+            assert_eq!(tets, tet_tags, "{name} {suffix}");
+            if msh && gmsh {
+                let o = Command::new("gmsh")
+                    .args([path.to_str().unwrap(), "-0", "-o"])
+                    .arg(tmp(&format!("groups_{name}_{suffix}_gmsh.msh")))
+                    .output()
+                    .unwrap();
+                let text = String::from_utf8_lossy(&o.stdout).to_string()
+                    + &String::from_utf8_lossy(&o.stderr);
+                assert!(o.status.success(), "gmsh {name} {suffix}: {text}");
+                assert!(
+                    !text.contains("Warning") && !text.contains("Error"),
+                    "gmsh {name} {suffix}: {text}"
+                );
             }
             let mut entry = serde_json::json!({
                 "path": path.to_str().unwrap(),
                 "key": if msh { "gmsh:physical" } else { "BoundaryTag" },
                 "tri": tri,
-                "tet": if msh { vec![*vol] } else { vec![0] },
+                "tet": tet_tags,
             });
             if named {
                 entry["names"] = serde_json::json!(names
@@ -938,7 +1066,7 @@ fn groups_survive_every_output_format() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(out.status.success(), "meshio failed:\n{text}");
-    assert!(text.contains("meshio ok 21"), "{text}");
+    assert!(text.contains("meshio ok 28"), "{text}");
     assert!(
         !text.to_lowercase().contains("warn"),
         "meshio warned:\n{text}"

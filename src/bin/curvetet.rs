@@ -11,7 +11,9 @@ use curvetet::surface::geometry::{
     triangle_shape, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
 };
 use curvetet::surface::Repair;
-use curvetet::{Error, Generated, Options, SizeFrom, SizeMode, Surface};
+use curvetet::{
+    Error, Generated, MeshInput, Options, RegionMode, Regions, SizeFrom, SizeMode, Surface,
+};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
@@ -71,6 +73,10 @@ enum Cmd {
         /// Draw the scaled-Jacobian and skewness histograms of a volume mesh as SVG here.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// For a surface: take a closed shell nested in another as an inner region, not a
+        /// cavity (as `mesh --nested-regions`)
+        #[arg(long)]
+        nested_regions: bool,
         #[command(flatten)]
         curve: CurveArgs,
     },
@@ -119,6 +125,11 @@ struct MeshArgs {
     /// memory available when the run starts
     #[arg(long, value_parser = parse_bytes)]
     max_memory: Option<u64>,
+    /// Take a closed shell nested in another as the boundary of an inner region to mesh
+    /// too, not as a cavity (several regions are found without it where the triangles
+    /// meet at junction edges: an interface between two regions given once)
+    #[arg(long)]
+    nested_regions: bool,
 }
 
 /// `123`, `64K`, `500M`, `4G`, `1T` (powers of 1024; a trailing `B`/`iB` is allowed).
@@ -362,8 +373,9 @@ fn main() -> ExitCode {
             file,
             json,
             plot,
+            nested_regions,
             curve,
-        } => cmd_check(&file, json, plot.as_deref(), &curve),
+        } => cmd_check(&file, json, plot.as_deref(), nested_regions, &curve),
         Cmd::Convert {
             input,
             output,
@@ -446,16 +458,16 @@ struct InputInfo {
 }
 
 fn run_mesh(
-    surface: &Surface,
+    mesh_input: &MeshInput,
     m: &MeshOptions,
     output: &Path,
     input: InputInfo,
 ) -> Result<(), Error> {
-    for w in surface.warnings() {
+    for w in mesh_input.warnings() {
         eprintln!("warning: {w}");
     }
     let opts = m.options();
-    if let SizeMode::Fixed(l) = opts.size {
+    if let (SizeMode::Fixed(l), MeshInput::Surface(surface)) = (opts.size, mesh_input) {
         let most = curvetet::generate::supported_size(surface);
         if l > most {
             eprintln!(
@@ -470,7 +482,15 @@ fn run_mesh(
         pb.set_position((f * 1000.0) as u64);
         false
     };
-    let r = curvetet::generate_with_progress(surface, &opts, &mut cb);
+    if let MeshInput::Regions(r) = mesh_input {
+        if !m.quiet {
+            eprintln!(
+                "{} regions: meshing each on its own boundary, into one conforming mesh",
+                r.regions().len()
+            );
+        }
+    }
+    let r = curvetet::generate_input(mesh_input, &opts, &mut cb);
     pb.finish_and_clear();
     let g: Generated = match r {
         Ok(g) => g,
@@ -510,6 +530,13 @@ fn run_mesh(
         r.quality.min_dihedral.min,
         r.quality.max_dihedral.max,
     );
+    let names = io::region_names(&g.mesh);
+    for (x, (_, name)) in g.regions.iter().zip(&names) {
+        eprintln!(
+            "  region {} ({name}): {} tets, volume {:.9}, min scaled Jacobian {:.3}",
+            x.id, x.report.num_tets, x.report.volume_curved, x.report.quality.scaled_jacobian.min
+        );
+    }
     eprintln!("wrote {}", output.display());
     if let Some(p) = &m.plot {
         write_plot(p, r, &output.display().to_string())?;
@@ -519,12 +546,12 @@ fn run_mesh(
             serde_json::to_value(&g.times).map_err(|e| Error::InvalidArgument(e.to_string()))?;
         times["read"] = input.read_seconds.into();
         times["write"] = write_seconds.into();
-        let json = serde_json::json!({
+        let mut json = serde_json::json!({
             "curvetet_version": env!("CARGO_PKG_VERSION"),
             "input": input.json,
             "output": output.display().to_string(),
             "options": options_json(&opts, &m.write.options()),
-            "input_triangles": surface.triangles().len(),
+            "input_triangles": mesh_input.num_triangles(),
             "report": r,
             "front": g.front,
             "times": times,
@@ -532,6 +559,10 @@ fn run_mesh(
             "size": g.size,
             "size_from": g.size_from,
         });
+        if !g.regions.is_empty() {
+            json["regions"] = serde_json::to_value(&g.regions)
+                .map_err(|e| Error::InvalidArgument(e.to_string()))?;
+        }
         let text = serde_json::to_string_pretty(&json)
             .map_err(|e| Error::InvalidArgument(e.to_string()))?;
         io::write_atomic(path, |w| w.write_all(text.as_bytes()))?;
@@ -539,16 +570,20 @@ fn run_mesh(
     Ok(())
 }
 
-/// The surface in `path`: P2 as it is, linear curved (with a summary on stderr).
-fn read_surface_any(path: &Path, c: &CurveArgs) -> Result<Surface, Error> {
+/// What `path` holds to mesh: several regions (see [`RegionMode`]), or one surface: P2
+/// as it is, linear curved (with a summary on stderr).
+fn read_input(path: &Path, c: &CurveArgs, mode: RegionMode) -> Result<MeshInput, Error> {
     let raw = io::read(path)?;
     let name = path.display().to_string();
+    if MeshInput::several_regions(&raw, mode) {
+        return MeshInput::from_raw(raw, &name, &c.options(), mode);
+    }
     if !raw.tri6.is_empty() || raw.tri3.is_empty() {
-        return io::surface_from_raw_with_repair(raw, &name, c.repair());
+        return io::surface_from_raw_with_repair(raw, &name, c.repair()).map(MeshInput::Surface);
     }
     let (s, r) = curve_raw(raw, &name, c)?;
     eprintln!("{}", curve_summary(&name, &s, &r));
-    Ok(s)
+    Ok(MeshInput::Surface(s))
 }
 
 /// Curves a linear surface read from a file.
@@ -668,31 +703,37 @@ fn cmd_mesh(a: &MeshArgs) -> Result<(), Error> {
     // The surface checks (parallel) run on as many threads as the meshing: `--threads 1`
     // is one thread from start to end.
     let t = std::time::Instant::now();
-    let surface = curvetet::threads::pool(a.mesh.threads, true)?
-        .install(|| read_surface_any(&a.input, &a.curve))?;
+    let mode = if a.nested_regions {
+        RegionMode::EveryShell
+    } else {
+        RegionMode::Auto
+    };
+    let mesh_input = curvetet::threads::pool(a.mesh.threads, true)?
+        .install(|| read_input(&a.input, &a.curve, mode))?;
     let input = InputInfo {
         json: serde_json::json!({
             "path": a.input.display().to_string(),
             "feature_angle": a.curve.feature_angle,
             "smooth": a.curve.smooth,
             "strict": a.curve.strict,
-            "warnings": surface.warnings(),
+            "regions": mesh_input.num_regions(),
+            "warnings": mesh_input.warnings(),
         }),
         read_seconds: t.elapsed().as_secs_f64(),
     };
     if let Some((budget, what)) = &budget {
-        let need = curvetet::generate::estimated_peak_memory(&surface, &a.mesh.options());
+        let need = mesh_input.estimated_peak_memory(&a.mesh.options());
         if need > *budget {
             return Err(Error::InvalidArgument(format!(
                 "{}: meshing {} triangles needs at least about {} (estimate), more than \
                  {what}",
                 a.input.display(),
-                surface.triangles().len(),
+                mesh_input.num_triangles(),
                 mib(need),
             )));
         }
     }
-    run_mesh(&surface, &a.mesh, &a.output, input)
+    run_mesh(&mesh_input, &a.mesh, &a.output, input)
 }
 
 fn cmd_curve(input: &Path, output: &Path, c: &CurveArgs, w: &WriteArgs) -> Result<(), Error> {
@@ -769,7 +810,7 @@ fn cmd_demo(
         json: serde_json::json!({"demo": "torus", "R": big_r, "r": r, "triangles": n}),
         read_seconds: 0.0,
     };
-    run_mesh(&surface, m, output, input)
+    run_mesh(&MeshInput::Surface(surface), m, output, input)
 }
 
 fn cmd_convert(input: &Path, output: &Path, w: &WriteArgs) -> Result<(), Error> {
@@ -821,13 +862,84 @@ fn shape_line(s: &Surface) -> String {
     )
 }
 
-fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Result<(), Error> {
+/// `check`'s report on a surface of several regions.
+fn say_regions(name: &str, r: &Regions, json: bool) -> Result<(), Error> {
+    for w in r.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let names: Vec<String> = r
+        .regions()
+        .iter()
+        .map(|x| {
+            r.groups()
+                .name(3, x.id)
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("{}{}", io::REGION_NAME_PREFIX, x.id))
+        })
+        .collect();
+    if json {
+        let list: Vec<serde_json::Value> = r
+            .regions()
+            .iter()
+            .zip(&names)
+            .map(|(x, n)| {
+                serde_json::json!({
+                    "id": x.id, "name": n, "triangles": x.surface.triangles().len(),
+                    "shells": x.surface.shell_count(), "enclosed_volume": x.surface.volume(),
+                    "enclosed_volume_linear": x.surface.chord_volume(),
+                })
+            })
+            .collect();
+        let j = serde_json::json!({
+            "kind": "regions", "file": name, "valid": true,
+            "triangles": r.num_triangles(), "regions": list, "warnings": r.warnings(),
+        });
+        say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
+    } else {
+        say!(
+            "{name}: valid surface of {} regions, {} triangles (interfaces once)",
+            r.regions().len(),
+            r.num_triangles()
+        )?;
+        for (x, n) in r.regions().iter().zip(&names) {
+            say!(
+                "  region {} \"{n}\": {} boundary triangles, {} shells, enclosed volume {:.12} \
+                 (linear {:.12})",
+                x.id,
+                x.surface.triangles().len(),
+                x.surface.shell_count(),
+                x.surface.volume(),
+                x.surface.chord_volume()
+            )?;
+        }
+    }
+    Ok(())
+}
+
+fn cmd_check(
+    path: &Path,
+    json: bool,
+    plot: Option<&Path>,
+    nested_regions: bool,
+    c: &CurveArgs,
+) -> Result<(), Error> {
+    let mode = if nested_regions {
+        RegionMode::EveryShell
+    } else {
+        RegionMode::Auto
+    };
     let plots: Vec<&Path> = plot.into_iter().collect();
     check_outputs(Some(path), &[], &plots, &WriteOptions::default())?;
     c.options().validate()?;
     let raw = io::read(path)?;
     let name = path.display().to_string();
     let linear = raw.tri6.is_empty() && !raw.tri3.is_empty();
+    if MeshInput::several_regions(&raw, mode) {
+        let MeshInput::Regions(r) = MeshInput::from_raw(raw, &name, &c.options(), mode)? else {
+            unreachable!("several regions")
+        };
+        return say_regions(&name, &r, json);
+    }
     if linear && raw.tet10.is_empty() && raw.tet4.is_empty() {
         let (s, r) = curve_raw(raw, &name, c)?;
         for w in s.warnings() {
@@ -920,6 +1032,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
             c
         });
     let m: TetMesh = raw.into_tet_mesh()?;
+    let region_name = |t: i32| m.groups.name(3, t).unwrap_or("").to_string();
     let conf = check::check_conformity_regions(&m, &regions)?;
     let report = QualityReport::of(&m);
     if let Some(p) = plot {
@@ -930,7 +1043,7 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
     if json {
         let j = serde_json::json!({
             "kind": "volume", "file": name, "valid": ok, "conformity": conf,
-            "regions": region_counts.iter().map(|(t, n)| serde_json::json!({"tag": t, "tets": n})).collect::<Vec<_>>(),
+            "regions": region_counts.iter().map(|(t, n)| serde_json::json!({"tag": t, "name": region_name(*t), "tets": n})).collect::<Vec<_>>(),
             "volume_relative_difference": rel, "report": report,
         });
         say!("{}", serde_json::to_string_pretty(&j).unwrap_or_default())?;
@@ -953,7 +1066,10 @@ fn cmd_check(path: &Path, json: bool, plot: Option<&Path>, c: &CurveArgs) -> Res
         if region_counts.len() > 1 {
             let list: Vec<String> = region_counts
                 .iter()
-                .map(|(t, n)| format!("{t} ({n} tets)"))
+                .map(|(t, n)| match region_name(*t) {
+                    x if x.is_empty() => format!("{t} ({n} tets)"),
+                    x => format!("{t} \"{x}\" ({n} tets)"),
+                })
                 .collect();
             say!(
                 "  regions: {}; {} interface triangles between them",
