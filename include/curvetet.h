@@ -79,6 +79,15 @@
 #define CURVETET_SURFACE_STRICT 1
 
 /**
+ * Flag of `curvetet_surface_from_arrays_with_flags` and `curvetet_surface_read_with_flags`:
+ * take a closed shell nested in another as the boundary of an inner region to mesh, not
+ * as a cavity. Without it, a surface is taken as several regions only where its
+ * triangles meet at junction edges (an edge of three or more triangles) and two regions
+ * share interface triangles.
+ */
+#define CURVETET_SURFACE_NESTED_REGIONS 2
+
+/**
  * The result of every fallible curvetet call. `CURVETET_OK` (0) is success; on any
  * other value `curvetet_last_error_message()` says what went wrong.
  */
@@ -149,8 +158,11 @@ typedef struct curvetet_mesh curvetet_mesh;
 
 /**
  * A closed quadratic (6-node) triangle surface, checked on creation (closed, manifold,
- * consistently oriented, no self-intersection, ...). Opaque. Immutable once created, so
- * it may be used from several threads at once (e.g. two `curvetet_generate` calls).
+ * consistently oriented, no self-intersection, ...), or a surface of several regions
+ * (materials sharing interfaces: each interface triangle given once; each region's
+ * boundary checked; see `curvetet_surface_num_regions`). Opaque. Immutable once
+ * created, so it may be used from several threads at once (e.g. two `curvetet_generate`
+ * calls).
  */
 typedef struct curvetet_surface curvetet_surface;
 
@@ -404,6 +416,30 @@ size_t curvetet_mesh_num_tets(const struct curvetet_mesh *m);
 enum curvetet_status curvetet_mesh_tets(const struct curvetet_mesh *m,
                                         curvetet_node_order order,
                                         uint32_t *out);
+
+/**
+ * Number of regions of the mesh (distinct region ids, `curvetet_mesh_tet_regions`): 1
+ * for a closed surface, more for a surface of several regions; 0 if `m` is NULL (and the
+ * last error message says so).
+ *
+ * # Safety
+ * `m` must be NULL or a live mesh.
+ */
+size_t curvetet_mesh_num_regions(const struct curvetet_mesh *m);
+
+/**
+ * Copy the region id of each tetrahedron into `out`, which must hold
+ * `curvetet_mesh_num_tets(m)` ints (in the order of `curvetet_mesh_tets`). Region ids
+ * are positive: 1..n for a surface of several regions (in the order of each region's
+ * lowest input triangle; the physical volume numbers of the written files), and the
+ * volume's physical tag (1 unless the input file numbered it) for one region.
+ *
+ * Errors: `CURVETET_ERR_INVALID_ARGUMENT` when `m` or `out` is NULL (with tets).
+ *
+ * # Safety
+ * `m` must be a live mesh and `out` hold the count above.
+ */
+enum curvetet_status curvetet_mesh_tet_regions(const struct curvetet_mesh *m, int32_t *out);
 
 /**
  * Number of boundary triangles: the input surface's triangles, each exactly once.
@@ -708,6 +744,17 @@ const double *curvetet_surface_nodes(const struct curvetet_surface *s);
 enum curvetet_status curvetet_surface_triangles(const struct curvetet_surface *s,
                                                 uint32_t *tri6_out,
                                                 int32_t *tags_out);
+
+/**
+ * Number of regions the surface bounds: 1 for a closed surface (with or without
+ * cavities), more for a surface of several regions (its mesh then has a region id per
+ * tet, `curvetet_mesh_tet_regions`); 0 if `s` is NULL (and the last error message says
+ * so).
+ *
+ * # Safety
+ * `s` must be NULL or a live surface.
+ */
+size_t curvetet_surface_num_regions(const struct curvetet_surface *s);
 
 /**
  * Number of warnings raised while checking the surface (e.g. "orientation was inward;

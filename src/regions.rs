@@ -65,6 +65,9 @@ pub struct Region {
 /// A surface of several regions, split and checked (see the [module docs](self)).
 #[derive(Debug, Clone)]
 pub struct Regions {
+    /// The input nodes and triangles (each interface once).
+    nodes: Vec<P3>,
+    tris: Vec<[u32; 6]>,
     n_nodes: usize,
     n_triangles: usize,
     tags: Vec<i32>,
@@ -148,6 +151,8 @@ impl Regions {
         Ok(Regions {
             n_nodes: nodes.len(),
             n_triangles: tris.len(),
+            nodes,
+            tris,
             tags,
             groups,
             regions,
@@ -208,6 +213,22 @@ impl Regions {
     pub fn num_triangles(&self) -> usize {
         self.n_triangles
     }
+
+    /// The input nodes.
+    pub fn nodes(&self) -> &[P3] {
+        &self.nodes
+    }
+
+    /// The input triangles, as given (each interface once).
+    pub fn triangles(&self) -> &[[u32; 6]] {
+        &self.tris
+    }
+
+    /// One tag per input triangle (interfaces of an untagged input have their own; see
+    /// the [module docs](self)).
+    pub fn tags(&self) -> &[i32] {
+        &self.tags
+    }
 }
 
 /// 6-node triangles with straight edges from 3-node ones: one new node at the midpoint
@@ -266,6 +287,18 @@ pub enum MeshInput {
     Surface(Surface),
     /// Several regions: [`generate_regions`].
     Regions(Regions),
+}
+
+impl From<Surface> for MeshInput {
+    fn from(s: Surface) -> MeshInput {
+        MeshInput::Surface(s)
+    }
+}
+
+impl From<Regions> for MeshInput {
+    fn from(r: Regions) -> MeshInput {
+        MeshInput::Regions(r)
+    }
 }
 
 impl MeshInput {
@@ -333,6 +366,27 @@ impl MeshInput {
         }
     }
 
+    /// The input of P2 arrays (as [`Surface::new_with_repair`] takes them): one checked
+    /// surface, or several regions under `mode` ([`MeshInput::several_regions`]).
+    pub fn from_arrays(
+        nodes: Vec<P3>,
+        tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        repair: Repair,
+        mode: RegionMode,
+    ) -> Result<MeshInput> {
+        let raw = RawMesh {
+            nodes,
+            tri6: tris,
+            ..RawMesh::default()
+        };
+        if !MeshInput::several_regions(&raw, mode) {
+            return Surface::new_with_repair(raw.nodes, raw.tri6, tags, repair)
+                .map(MeshInput::Surface);
+        }
+        Regions::new(raw.nodes, raw.tri6, tags, repair).map(MeshInput::Regions)
+    }
+
     /// [`MeshInput::from_raw`] on the file `path`.
     pub fn read(path: &std::path::Path, curve: &CurveOptions, mode: RegionMode) -> Result<Self> {
         let raw = crate::io::read(path)?;
@@ -344,6 +398,30 @@ impl MeshInput {
         match self {
             MeshInput::Surface(_) => 1,
             MeshInput::Regions(r) => r.regions.len(),
+        }
+    }
+
+    /// The nodes: the surface's, or the input's of several regions.
+    pub fn nodes(&self) -> &[P3] {
+        match self {
+            MeshInput::Surface(s) => s.nodes(),
+            MeshInput::Regions(r) => r.nodes(),
+        }
+    }
+
+    /// The triangles: the surface's (outward), or the input's of several regions.
+    pub fn triangles(&self) -> &[[u32; 6]] {
+        match self {
+            MeshInput::Surface(s) => s.triangles(),
+            MeshInput::Regions(r) => r.triangles(),
+        }
+    }
+
+    /// One tag per triangle of [`MeshInput::triangles`].
+    pub fn tags(&self) -> &[i32] {
+        match self {
+            MeshInput::Surface(s) => s.tags(),
+            MeshInput::Regions(r) => r.tags(),
         }
     }
 

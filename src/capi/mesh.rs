@@ -8,7 +8,7 @@ use super::surface::{c_path, curvetet_surface, reset_out};
 use crate::io::order::{tet10_to, Convention};
 use crate::io::{MshVersion, WriteOptions};
 use crate::mesh::report::{element_qualities, QualityReport};
-use crate::{generate_with_progress, Error, Generated};
+use crate::{generate_input, Error, Generated};
 use std::ffi::{c_char, c_int, CString};
 use std::mem::{offset_of, size_of};
 use std::sync::OnceLock;
@@ -18,6 +18,8 @@ use std::sync::OnceLock;
 #[allow(non_camel_case_types)] // the C name fixed by the ABI contract
 pub struct curvetet_mesh {
     pub(crate) generated: Generated,
+    /// The region id of each tet (for one region: the volume's physical tag).
+    regions: Vec<i32>,
     /// The JSON report, made on first request.
     json: OnceLock<CString>,
 }
@@ -130,7 +132,7 @@ pub unsafe extern "C" fn curvetet_generate(
         let parsed = unsafe { parse(opt)? };
         let mut last: (f64, String) = (0.0, String::new());
         let result = match parsed.progress {
-            None => generate_with_progress(&s.surface, &parsed.options, &mut |_, _| false),
+            None => generate_input(&s.input, &parsed.options, &mut |_, _| false),
             Some(cb) => {
                 let user = parsed.user_data;
                 let mut stage_c = CString::default();
@@ -144,7 +146,7 @@ pub unsafe extern "C" fn curvetet_generate(
                     // user_data; `stage_c` outlives the call.
                     unsafe { cb(user, fraction, stage_c.as_ptr()) != 0 }
                 };
-                generate_with_progress(&s.surface, &parsed.options, &mut progress)
+                generate_input(&s.input, &parsed.options, &mut progress)
             }
         };
         let generated = match result {
@@ -160,8 +162,17 @@ pub unsafe extern "C" fn curvetet_generate(
             }
             Err(e) => return Err(e.into()),
         };
+        let mesh = &generated.mesh;
+        let regions = if mesh.tet_regions.is_empty() {
+            let tag = mesh.groups.volume_tag;
+            let tag = if tag > 0 { tag } else { crate::io::VOLUME_TAG };
+            vec![tag; mesh.tets.len()]
+        } else {
+            mesh.tet_regions.clone()
+        };
         let m = curvetet_mesh {
             generated,
+            regions,
             json: OnceLock::new(),
         };
         // SAFETY: `out` checked by reset_out.
@@ -259,6 +270,49 @@ pub unsafe extern "C" fn curvetet_mesh_tets(
             // SAFETY: `out` holds 10 * num_tets elements by contract; non-NULL, aligned.
             unsafe { std::ptr::copy_nonoverlapping(t.as_ptr(), out.add(10 * i), 10) };
         }
+        Ok(())
+    })
+}
+
+/// Number of regions of the mesh (distinct region ids, `curvetet_mesh_tet_regions`): 1
+/// for a closed surface, more for a surface of several regions; 0 if `m` is NULL (and the
+/// last error message says so).
+///
+/// # Safety
+/// `m` must be NULL or a live mesh.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_mesh_num_regions(m: *const curvetet_mesh) -> usize {
+    value_call("curvetet_mesh_num_regions", 0, || {
+        // SAFETY: live by contract.
+        let m = unsafe { deref(m, "m")? };
+        let mut ids = m.regions.clone();
+        ids.sort_unstable();
+        ids.dedup();
+        Ok(ids.len())
+    })
+}
+
+/// Copy the region id of each tetrahedron into `out`, which must hold
+/// `curvetet_mesh_num_tets(m)` ints (in the order of `curvetet_mesh_tets`). Region ids
+/// are positive: 1..n for a surface of several regions (in the order of each region's
+/// lowest input triangle; the physical volume numbers of the written files), and the
+/// volume's physical tag (1 unless the input file numbered it) for one region.
+///
+/// Errors: `CURVETET_ERR_INVALID_ARGUMENT` when `m` or `out` is NULL (with tets).
+///
+/// # Safety
+/// `m` must be a live mesh and `out` hold the count above.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_mesh_tet_regions(
+    m: *const curvetet_mesh,
+    out: *mut i32,
+) -> curvetet_status {
+    status_call("curvetet_mesh_tet_regions", || {
+        // SAFETY: live by contract.
+        let m = unsafe { deref(m, "m")? };
+        check_ptr(out.cast_const(), "out")?;
+        // SAFETY: buffer size by contract; NULL/alignment checked inside.
+        unsafe { copy_out(&m.regions, out, "out")? };
         Ok(())
     })
 }
@@ -481,6 +535,7 @@ pub unsafe extern "C" fn curvetet_mesh_report_json(m: *const curvetet_mesh) -> *
                 "front": g.front,
                 "times": g.times,
                 "optimize": g.optimize,
+                "regions": g.regions,
             });
             // serde_json escapes control characters, so the text has no NUL.
             CString::new(v.to_string()).unwrap_or_default()

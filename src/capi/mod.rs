@@ -29,10 +29,11 @@ mod tests;
 pub use mesh::{
     curvetet_generate, curvetet_mesh, curvetet_mesh_boundary_faces, curvetet_mesh_free,
     curvetet_mesh_nodes, curvetet_mesh_num_boundary_faces, curvetet_mesh_num_nodes,
-    curvetet_mesh_num_tets, curvetet_mesh_quality, curvetet_mesh_report_json,
-    curvetet_mesh_target_size, curvetet_mesh_tets, curvetet_mesh_write,
-    curvetet_mesh_write_with_flags, curvetet_node_order, curvetet_quality, NodeOrderArg,
-    CURVETET_WRITE_BINARY, CURVETET_WRITE_MEDIT_LINEAR, CURVETET_WRITE_MSH22, QUALITY_SIZE_V1,
+    curvetet_mesh_num_regions, curvetet_mesh_num_tets, curvetet_mesh_quality,
+    curvetet_mesh_report_json, curvetet_mesh_target_size, curvetet_mesh_tet_regions,
+    curvetet_mesh_tets, curvetet_mesh_write, curvetet_mesh_write_with_flags, curvetet_node_order,
+    curvetet_quality, NodeOrderArg, CURVETET_WRITE_BINARY, CURVETET_WRITE_MEDIT_LINEAR,
+    CURVETET_WRITE_MSH22, QUALITY_SIZE_V1,
 };
 pub use options::{
     curvetet_options, curvetet_progress_fn, OPTIONS_SIZE_V1, OPTIONS_SIZE_V2, OPTIONS_SIZE_V3,
@@ -41,9 +42,10 @@ pub use status::{curvetet_status, StatusArg};
 pub use surface::{
     curvetet_surface, curvetet_surface_free, curvetet_surface_from_arrays,
     curvetet_surface_from_arrays_with_flags, curvetet_surface_from_linear_with_flags,
-    curvetet_surface_nodes, curvetet_surface_num_nodes, curvetet_surface_num_triangles,
-    curvetet_surface_num_warnings, curvetet_surface_read, curvetet_surface_read_with_flags,
-    curvetet_surface_triangles, curvetet_surface_warning, CURVETET_SURFACE_STRICT,
+    curvetet_surface_nodes, curvetet_surface_num_nodes, curvetet_surface_num_regions,
+    curvetet_surface_num_triangles, curvetet_surface_num_warnings, curvetet_surface_read,
+    curvetet_surface_read_with_flags, curvetet_surface_triangles, curvetet_surface_warning,
+    CURVETET_SURFACE_NESTED_REGIONS, CURVETET_SURFACE_STRICT,
 };
 
 use guard::{check_ptr, status_call, value_call};

@@ -6,28 +6,31 @@ use super::guard::{
 };
 use super::status::curvetet_status;
 use crate::surface::Repair;
-use crate::{Result, Surface};
+use crate::{MeshInput, RegionMode, Result};
 use std::ffi::{c_char, CStr, CString};
 use std::path::PathBuf;
 
 /// A closed quadratic (6-node) triangle surface, checked on creation (closed, manifold,
-/// consistently oriented, no self-intersection, ...). Opaque. Immutable once created, so
-/// it may be used from several threads at once (e.g. two `curvetet_generate` calls).
+/// consistently oriented, no self-intersection, ...), or a surface of several regions
+/// (materials sharing interfaces: each interface triangle given once; each region's
+/// boundary checked; see `curvetet_surface_num_regions`). Opaque. Immutable once
+/// created, so it may be used from several threads at once (e.g. two `curvetet_generate`
+/// calls).
 #[allow(non_camel_case_types)] // the C name fixed by the ABI contract
 pub struct curvetet_surface {
-    pub(crate) surface: Surface,
+    pub(crate) input: MeshInput,
     /// The surface's warnings as C strings (owned here, handed out by pointer).
     warnings: Vec<CString>,
 }
 
 impl curvetet_surface {
-    fn new(surface: Surface) -> curvetet_surface {
-        let warnings = surface
+    fn new(input: MeshInput) -> curvetet_surface {
+        let warnings = input
             .warnings()
             .iter()
             .map(|w| CString::new(w.replace('\0', "\\0")).unwrap_or_default())
             .collect();
-        curvetet_surface { surface, warnings }
+        curvetet_surface { input, warnings }
     }
 }
 
@@ -35,9 +38,9 @@ impl curvetet_surface {
 ///
 /// # Safety
 /// `out` is non-NULL and aligned (checked by the caller of this helper).
-unsafe fn give(out: *mut *mut curvetet_surface, s: Surface) {
+unsafe fn give(out: *mut *mut curvetet_surface, s: impl Into<MeshInput>) {
     // SAFETY: see above.
-    unsafe { *out = Box::into_raw(Box::new(curvetet_surface::new(s))) };
+    unsafe { *out = Box::into_raw(Box::new(curvetet_surface::new(s.into()))) };
 }
 
 /// Set `*out` to NULL first, so that it is NULL on every failure.
@@ -154,7 +157,8 @@ unsafe fn from_arrays_call(
         };
         let nodes: Vec<[f64; 3]> = copy_groups(xyz, "xyz")?;
         let tris: Vec<[u32; 6]> = copy_groups(tri6, "tri6")?;
-        let s = Surface::new_with_repair(nodes, tris, tags, repair_of(flags)?)?;
+        let (repair, mode) = flags_of(flags)?;
+        let s = MeshInput::from_arrays(nodes, tris, tags, repair, mode)?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };
         Ok(())
@@ -168,18 +172,43 @@ unsafe fn from_arrays_call(
 /// consistently inside-out surface is still flipped, with a warning.
 pub const CURVETET_SURFACE_STRICT: u32 = 1;
 
-/// The repair policy `flags` (of `curvetet_surface_*_with_flags`) ask for; unknown bits
-/// are an error.
-fn repair_of(flags: u32) -> Result<Repair> {
-    let known = CURVETET_SURFACE_STRICT;
+/// Flag of `curvetet_surface_from_arrays_with_flags` and `curvetet_surface_read_with_flags`:
+/// take a closed shell nested in another as the boundary of an inner region to mesh, not
+/// as a cavity. Without it, a surface is taken as several regions only where its
+/// triangles meet at junction edges (an edge of three or more triangles) and two regions
+/// share interface triangles.
+pub const CURVETET_SURFACE_NESTED_REGIONS: u32 = 2;
+
+/// The repair policy and region mode `flags` (of `curvetet_surface_*_with_flags`) ask
+/// for; unknown bits are an error.
+fn flags_of(flags: u32) -> Result<(Repair, RegionMode)> {
+    let known = CURVETET_SURFACE_STRICT | CURVETET_SURFACE_NESTED_REGIONS;
     if flags & !known != 0 {
         return Err(invalid(format!("unknown flag bits {:#x}", flags & !known)));
     }
-    Ok(if flags & CURVETET_SURFACE_STRICT != 0 {
+    let repair = if flags & CURVETET_SURFACE_STRICT != 0 {
         Repair::Strict
     } else {
         Repair::Unambiguous
-    })
+    };
+    let mode = if flags & CURVETET_SURFACE_NESTED_REGIONS != 0 {
+        RegionMode::EveryShell
+    } else {
+        RegionMode::Auto
+    };
+    Ok((repair, mode))
+}
+
+/// The repair policy of `flags` for the linear constructor, which takes one surface only:
+/// `CURVETET_SURFACE_NESTED_REGIONS` is refused there.
+fn repair_of(flags: u32) -> Result<Repair> {
+    if flags & CURVETET_SURFACE_NESTED_REGIONS != 0 {
+        return Err(invalid(
+            "CURVETET_SURFACE_NESTED_REGIONS is for curvetet_surface_from_arrays_with_flags \
+             and curvetet_surface_read_with_flags",
+        ));
+    }
+    Ok(flags_of(flags)?.0)
 }
 
 /// `curvetet_surface_from_arrays` with `flags`: 0, or `CURVETET_SURFACE_STRICT`.
@@ -436,13 +465,14 @@ unsafe fn read_call(
     status_call(name, || {
         // SAFETY: checked inside.
         unsafe { reset_out(out)? };
+        let (repair, mode) = flags_of(flags)?;
         let opts = crate::surface::curve::CurveOptions {
-            repair: repair_of(flags)?,
+            repair,
             ..crate::surface::curve::CurveOptions::default()
         };
         // SAFETY: NUL-terminated by contract.
         let path = unsafe { c_path(path)? };
-        let s = crate::io::read_any_surface(&path, &opts)?;
+        let s = MeshInput::read(&path, &opts, mode)?;
         // SAFETY: `out` checked by reset_out.
         unsafe { give(out, s) };
         Ok(())
@@ -474,7 +504,7 @@ pub unsafe extern "C" fn curvetet_surface_free(s: *mut curvetet_surface) {
 pub unsafe extern "C" fn curvetet_surface_num_nodes(s: *const curvetet_surface) -> usize {
     value_call("curvetet_surface_num_nodes", 0, || {
         // SAFETY: live by contract.
-        Ok(unsafe { deref(s, "s")? }.surface.nodes().len())
+        Ok(unsafe { deref(s, "s")? }.input.nodes().len())
     })
 }
 
@@ -487,7 +517,7 @@ pub unsafe extern "C" fn curvetet_surface_num_nodes(s: *const curvetet_surface) 
 pub unsafe extern "C" fn curvetet_surface_num_triangles(s: *const curvetet_surface) -> usize {
     value_call("curvetet_surface_num_triangles", 0, || {
         // SAFETY: live by contract.
-        Ok(unsafe { deref(s, "s")? }.surface.triangles().len())
+        Ok(unsafe { deref(s, "s")? }.input.triangles().len())
     })
 }
 
@@ -502,7 +532,7 @@ pub unsafe extern "C" fn curvetet_surface_nodes(s: *const curvetet_surface) -> *
     value_call("curvetet_surface_nodes", std::ptr::null(), || {
         // SAFETY: live by contract.
         Ok(unsafe { deref(s, "s")? }
-            .surface
+            .input
             .nodes()
             .as_ptr()
             .cast::<f64>())
@@ -527,15 +557,30 @@ pub unsafe extern "C" fn curvetet_surface_triangles(
         // SAFETY: live by contract.
         let s = unsafe { deref(s, "s")? };
         check_ptr(tri6_out.cast_const(), "tri6_out")?;
-        let tris = s.surface.triangles();
+        let tris = s.input.triangles();
         // SAFETY: buffer sizes by contract; NULL/alignment checked inside.
         unsafe {
             copy_out(tris.as_flattened(), tri6_out, "tri6_out")?;
             if !tags_out.is_null() {
-                copy_out(s.surface.tags(), tags_out, "tags_out")?;
+                copy_out(s.input.tags(), tags_out, "tags_out")?;
             }
         }
         Ok(())
+    })
+}
+
+/// Number of regions the surface bounds: 1 for a closed surface (with or without
+/// cavities), more for a surface of several regions (its mesh then has a region id per
+/// tet, `curvetet_mesh_tet_regions`); 0 if `s` is NULL (and the last error message says
+/// so).
+///
+/// # Safety
+/// `s` must be NULL or a live surface.
+#[no_mangle]
+pub unsafe extern "C" fn curvetet_surface_num_regions(s: *const curvetet_surface) -> usize {
+    value_call("curvetet_surface_num_regions", 0, || {
+        // SAFETY: live by contract.
+        Ok(unsafe { deref(s, "s")? }.input.num_regions())
     })
 }
 

@@ -651,10 +651,11 @@ fn the_strict_flag_refuses_what_is_repaired_by_default() {
     assert_eq!(st, curvetet_status::CURVETET_ERR_INVALID_SURFACE);
     assert!(s.is_null());
     assert!(last_error().contains("unused-node"), "{}", last_error());
-    let (st, _) = from_arrays(2);
+    // Bit 1 is CURVETET_SURFACE_NESTED_REGIONS; bit 2 is unknown.
+    let (st, _) = from_arrays(4);
     assert_eq!(st, curvetet_status::CURVETET_ERR_INVALID_ARGUMENT);
     assert!(
-        last_error().contains("unknown flag bits 0x2"),
+        last_error().contains("unknown flag bits 0x4"),
         "{}",
         last_error()
     );
@@ -713,4 +714,31 @@ fn the_strict_flag_refuses_what_is_repaired_by_default() {
         // SAFETY: NULL or live.
         unsafe { curvetet_surface_free(s) };
     }
+    // The same file with its inner shell taken as a region: two regions, meshed into one
+    // mesh with a region id per tet.
+    let mut s = null_mut();
+    // SAFETY: a NUL-terminated path; the handles are live until freed.
+    unsafe {
+        let st =
+            curvetet_surface_read_with_flags(p.as_ptr(), CURVETET_SURFACE_NESTED_REGIONS, &mut s);
+        assert_eq!(st, curvetet_status::CURVETET_OK, "{}", last_error());
+        assert_eq!(curvetet_surface_num_regions(s), 2);
+        let mut m = null_mut();
+        let st = curvetet_generate(s, null(), &mut m);
+        assert_eq!(st, curvetet_status::CURVETET_OK, "{}", last_error());
+        assert_eq!(curvetet_mesh_num_regions(m), 2);
+        let n = curvetet_mesh_num_tets(m);
+        let mut reg = vec![0i32; n];
+        let st = curvetet_mesh_tet_regions(m, reg.as_mut_ptr());
+        assert_eq!(st, curvetet_status::CURVETET_OK);
+        assert_eq!(reg, (*m).generated.mesh.tet_regions);
+        assert!(reg.contains(&1) && reg.contains(&2));
+        curvetet_mesh_free(m);
+        curvetet_surface_free(s);
+    }
+    // The linear constructor takes one surface only.
+    assert_eq!(
+        linear(CURVETET_SURFACE_NESTED_REGIONS),
+        curvetet_status::CURVETET_ERR_INVALID_ARGUMENT
+    );
 }

@@ -642,6 +642,142 @@ static void test_cancel(const curvetet_surface *s, double limit_ms) {
     CHECK(late < limit_ms);
 }
 
+/* ---------------------------------------------------------------- regions */
+
+/* Two unit boxes [0,1]x[0,1]^2 and [1,2]x[0,1]^2 sharing the wall x = 1 (given once),
+ * two flat P2 triangles per unit square, in no particular orientation. */
+static double g_rx[3 * 64];
+static size_t g_rn;
+
+static uint32_t region_node(double x, double y, double z) {
+    for (size_t i = 0; i < g_rn; i++)
+        if (g_rx[3 * i] == x && g_rx[3 * i + 1] == y && g_rx[3 * i + 2] == z) return (uint32_t)i;
+    REQUIRE(g_rn < 64);
+    g_rx[3 * g_rn] = x;
+    g_rx[3 * g_rn + 1] = y;
+    g_rx[3 * g_rn + 2] = z;
+    return (uint32_t)g_rn++;
+}
+
+static uint32_t region_mid(uint32_t a, uint32_t b) {
+    return region_node((g_rx[3 * a] + g_rx[3 * b]) / 2, (g_rx[3 * a + 1] + g_rx[3 * b + 1]) / 2,
+                       (g_rx[3 * a + 2] + g_rx[3 * b + 2]) / 2);
+}
+
+/* The unit square at coordinate `at` of `axis`, spanning [u0, u0 + 1] x [0, 1] in the
+ * next two axes. */
+static void region_square(uint32_t *tri, size_t *nt, int axis, double at, double u0) {
+    uint32_t c[4];
+    const double uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int k = 0; k < 4; k++) {
+        double p[3];
+        p[axis] = at;
+        p[(axis + 1) % 3] = uv[k][0] + ((axis + 1) % 3 == 0 ? u0 : 0);
+        p[(axis + 2) % 3] = uv[k][1] + ((axis + 2) % 3 == 0 ? u0 : 0);
+        c[k] = region_node(p[0], p[1], p[2]);
+    }
+    const int q[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int h = 0; h < 2; h++) {
+        uint32_t *t = tri + 6 * (*nt)++;
+        t[0] = c[q[h][0]];
+        t[1] = c[q[h][1]];
+        t[2] = c[q[h][2]];
+        t[3] = region_mid(t[0], t[1]);
+        t[4] = region_mid(t[1], t[2]);
+        t[5] = region_mid(t[2], t[0]);
+    }
+}
+
+static int cmp_u32(const void *a, const void *b) {
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+static void test_two_regions(void) {
+    uint32_t tri[6 * 22];
+    size_t nt = 0;
+    g_rn = 0;
+    region_square(tri, &nt, 0, 0, 0);
+    region_square(tri, &nt, 0, 1, 0); /* the wall, once */
+    region_square(tri, &nt, 0, 2, 0);
+    for (int b = 0; b < 2; b++) {
+        region_square(tri, &nt, 1, 0, b); /* y = 0 and y = 1: x is the third axis */
+        region_square(tri, &nt, 1, 1, b);
+        region_square(tri, &nt, 2, 0, b); /* z = 0 and z = 1: x is the second axis */
+        region_square(tri, &nt, 2, 1, b);
+    }
+    REQUIRE(nt == 22);
+    curvetet_surface *s = NULL;
+    EXPECT_STATUS(curvetet_surface_from_arrays(g_rx, g_rn, tri, nt, NULL, &s), CURVETET_OK);
+    REQUIRE(s != NULL);
+    CHECK(curvetet_surface_num_regions(s) == 2);
+    CHECK(curvetet_surface_num_triangles(s) == 22);
+    curvetet_options o;
+    curvetet_options_default(&o);
+    o.threads = 1;
+    curvetet_mesh *m = NULL;
+    EXPECT_STATUS(curvetet_generate(s, &o, &m), CURVETET_OK);
+    REQUIRE(m != NULL);
+    CHECK(curvetet_mesh_num_regions(m) == 2);
+    size_t n = curvetet_mesh_num_tets(m);
+    uint32_t *tets = (uint32_t *)xmalloc(10 * n * sizeof(uint32_t));
+    int32_t *reg = (int32_t *)xmalloc(n * sizeof(int32_t));
+    EXPECT_STATUS(curvetet_mesh_tets(m, CURVETET_ORDER_GMSH, tets), CURVETET_OK);
+    EXPECT_STATUS(curvetet_mesh_tet_regions(m, reg), CURVETET_OK);
+    /* Each region fills its box: linear volumes 1 and 1. */
+    const double *x = curvetet_mesh_nodes(m);
+    double vol[3] = {0, 0, 0};
+    for (size_t t = 0; t < n; t++) {
+        CHECK(reg[t] == 1 || reg[t] == 2);
+        if (reg[t] != 1 && reg[t] != 2) continue;
+        const double *a = x + 3 * tets[10 * t], *b = x + 3 * tets[10 * t + 1],
+                     *c = x + 3 * tets[10 * t + 2], *d = x + 3 * tets[10 * t + 3];
+        double u[3], v[3], w[3];
+        for (int k = 0; k < 3; k++) {
+            u[k] = b[k] - a[k];
+            v[k] = c[k] - a[k];
+            w[k] = d[k] - a[k];
+        }
+        vol[reg[t]] += (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                        u[2] * (v[0] * w[1] - v[1] * w[0])) /
+                       6;
+    }
+    CHECK(fabs(vol[1] - 1) < 1e-10 && fabs(vol[2] - 1) < 1e-10);
+    /* The wall's two triangles (input triangles 2 and 3) are each a face of one tet of
+     * each region. */
+    for (int w = 2; w < 4; w++) {
+        uint32_t f[3] = {tri[6 * w], tri[6 * w + 1], tri[6 * w + 2]};
+        qsort(f, 3, sizeof f[0], cmp_u32);
+        int count[3] = {0, 0, 0};
+        static const int faces[4][3] = {{0, 1, 2}, {0, 1, 3}, {1, 2, 3}, {0, 2, 3}};
+        for (size_t t = 0; t < n; t++) {
+            for (int k = 0; k < 4; k++) {
+                uint32_t g[3] = {tets[10 * t + faces[k][0]], tets[10 * t + faces[k][1]],
+                                 tets[10 * t + faces[k][2]]};
+                qsort(g, 3, sizeof g[0], cmp_u32);
+                if (memcmp(f, g, sizeof f) == 0 && (reg[t] == 1 || reg[t] == 2)) count[reg[t]]++;
+            }
+        }
+        CHECK(count[1] == 1 && count[2] == 1);
+    }
+    /* The interface is kept once among the boundary triangles. */
+    CHECK(curvetet_mesh_num_boundary_faces(m) == 22);
+    EXPECT_STATUS(curvetet_mesh_tet_regions(m, NULL), CURVETET_ERR_INVALID_ARGUMENT);
+    EXPECT_STATUS(curvetet_mesh_tet_regions(NULL, reg), CURVETET_ERR_INVALID_ARGUMENT);
+    CHECK(curvetet_mesh_num_regions(NULL) == 0);
+    CHECK(curvetet_surface_num_regions(NULL) == 0);
+    {
+        char *path = join_path(g_out, "two_regions.msh");
+        EXPECT_STATUS(curvetet_mesh_write(m, path), CURVETET_OK);
+        free(path);
+    }
+    free(tets);
+    free(reg);
+    curvetet_mesh_free(m);
+    curvetet_surface_free(s);
+    printf("  two regions: %zu tets, volumes %.12f + %.12f\n", n, vol[1], vol[2]);
+}
+
 int main(int argc, char **argv) {
     if (argc != 3) {
         fprintf(stderr, "usage: %s DATA_DIR OUT_DIR\n", argv[0]);
@@ -661,6 +797,7 @@ int main(int argc, char **argv) {
     test_options();
     test_errors_without_mesh();
     test_from_linear();
+    test_two_regions();
 
     /* The sphere, read from its file. */
     char *sphere = join_path(g_data, "sphere_p2.msh");
