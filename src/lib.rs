@@ -42,7 +42,7 @@ pub mod io;
 
 mod error;
 mod options;
-mod regions;
+pub mod regions;
 
 // The modules below are public only for this repository's command-line tool, tests,
 // benchmarks and examples (and the C ABI's symbols): not part of the library's API, hidden

@@ -4,14 +4,14 @@
 //! appears once, so the surface is non-manifold along the junctions where an interface
 //! meets the outer boundary (as Gmsh physical surfaces bounding several physical
 //! volumes, or a triangle soup of materials) — is split into one closed boundary per
-//! region ([`crate::surface::regions`]); each region is meshed by [`generate`] on its
+//! region ([`crate::surface::regions`]); each region is meshed by [`generate`](crate::generate()) on its
 //! own boundary, kept exactly, so the meshes share every interface node and triangle;
 //! the meshes are merged into one [`TetMesh`] with a region id per tet
 //! ([`TetMesh::tet_regions`]) and each interface triangle once among the boundary
 //! triangles.
 //!
 //! [`MeshInput`] is what the command-line tool and the C ABI mesh: one closed surface
-//! (possibly with cavities) takes exactly the single-surface path ([`generate`] on a
+//! (possibly with cavities) takes exactly the single-surface path ([`generate`](crate::generate()) on a
 //! [`Surface`]); a surface of several regions takes this one ([`generate_regions`]).
 //!
 //! Region ids are 1..n in the order of each region's lowest input triangle; regions are
@@ -283,7 +283,7 @@ pub struct RegionResult {
 /// A surface to mesh: one closed surface, or several regions.
 #[derive(Debug, Clone)]
 pub enum MeshInput {
-    /// One closed surface (possibly with cavities): [`generate`].
+    /// One closed surface (possibly with cavities): [`generate`](crate::generate()).
     Surface(Surface),
     /// Several regions: [`generate_regions`].
     Regions(Regions),

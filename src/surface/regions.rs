@@ -23,7 +23,7 @@
 //!    [`chord_volume_sign`]).
 //! 3. **Nesting.** A negative shell belongs to the innermost positive shell containing
 //!    it (exact ray parity from one of its vertices that is not on that shell,
-//!    [`ray_crosses`]); one contained by no positive shell faces the exterior and is
+//!    `ray_crosses`); one contained by no positive shell faces the exterior and is
 //!    dropped. A region is a positive shell with its cavity shells.
 //!
 //! Regions are numbered 1..n in the order of their outer shell's lowest triangle. Each
