@@ -187,7 +187,12 @@ int vtkCurveTetFilter::ProgressCallback(void* user, double fraction, const char*
   // when it starts again, from 0), "optimize" (0, then 0.5), then "certify"; the copy
   // into VTK takes the rest. Progress shown never goes back.
   double p = self->LastProgress;
-  if (stage && std::strncmp(stage, "front", 5) == 0)
+  if (stage && std::strncmp(stage, "region ", 7) == 0)
+  {
+    // A surface of several regions: "region ID: STAGE", the fraction over all regions.
+    p = 0.05 + 0.85 * fraction;
+  }
+  else if (stage && std::strncmp(stage, "front", 5) == 0)
   {
     p = 0.05 + 0.7 * fraction;
   }
@@ -311,7 +316,11 @@ int vtkCurveTetFilter::RequestData(
   vtkNew<vtkDoubleArray> skew;
   skew->SetName("EquiangularSkewness");
   skew->SetNumberOfValues(static_cast<vtkIdType>(numTets));
+  vtkNew<vtkIntArray> region;
+  region->SetName("Region");
+  region->SetNumberOfValues(static_cast<vtkIdType>(numTets));
   if (curvetet_mesh_tets(mesh.get(), CURVETET_ORDER_VTK, tets.data()) != CURVETET_OK ||
+    curvetet_mesh_tet_regions(mesh.get(), region->GetPointer(0)) != CURVETET_OK ||
     curvetet_mesh_boundary_faces(mesh.get(), faces.data(), faceTags.data()) != CURVETET_OK ||
     curvetet_mesh_tet_quality(mesh.get(), sj->GetPointer(0), skew->GetPointer(0)) != CURVETET_OK)
   {
@@ -323,6 +332,7 @@ int vtkCurveTetFilter::RequestData(
   SetCells(output, VTK_QUADRATIC_TETRA, 10, tets);
   output->GetCellData()->AddArray(sj);
   output->GetCellData()->AddArray(skew);
+  output->GetCellData()->AddArray(region);
 
   boundary->SetPoints(points);
   SetCells(boundary, VTK_QUADRATIC_TRIANGLE, 6, faces);

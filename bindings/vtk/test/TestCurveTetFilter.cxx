@@ -544,6 +544,74 @@ void TestP2(const std::string& msh)
     static_cast<long long>(coarse));
 }
 
+// A P2 surface of two regions (two boxes sharing a wall, the wall given once): the
+// output has a Region cell array with both ids, each region filling its unit box, and the
+// boundary output lists every input triangle once (the wall included).
+void TestRegions(const std::string& msh)
+{
+  curvetet_surface* s = nullptr;
+  REQUIRE(curvetet_surface_read(msh.c_str(), &s) == CURVETET_OK);
+  CHECK(curvetet_surface_num_regions(s) == 2);
+  const size_t nn = curvetet_surface_num_nodes(s), nt = curvetet_surface_num_triangles(s);
+  std::vector<uint32_t> tri(6 * nt);
+  CHECK(curvetet_surface_triangles(s, tri.data(), nullptr) == CURVETET_OK);
+  vtkNew<vtkDoubleArray> xyz;
+  xyz->SetNumberOfComponents(3);
+  xyz->SetNumberOfTuples(static_cast<vtkIdType>(nn));
+  std::memcpy(xyz->GetPointer(0), curvetet_surface_nodes(s), 3 * nn * sizeof(double));
+  curvetet_surface_free(s);
+  vtkNew<vtkUnstructuredGrid> in;
+  vtkNew<vtkPoints> pts;
+  pts->SetData(xyz);
+  in->SetPoints(pts);
+  in->Allocate(static_cast<vtkIdType>(nt));
+  for (size_t t = 0; t < nt; ++t)
+  {
+    vtkIdType ids[6];
+    for (int k = 0; k < 6; ++k)
+      ids[k] = tri[6 * t + k];
+    in->InsertNextCell(VTK_QUADRATIC_TRIANGLE, 6, ids);
+  }
+  vtkNew<vtkCurveTetFilter> filter;
+  filter->SetInputData(in);
+  filter->SetNumberOfThreads(1);
+  Messages msgs;
+  msgs.Watch(filter);
+  filter->Update();
+  CHECK(msgs.errors == 0);
+  vtkUnstructuredGrid* out = filter->GetOutput(0);
+  vtkDataArray* region = out->GetCellData()->GetArray("Region");
+  REQUIRE(region != nullptr);
+  REQUIRE(out->GetNumberOfCells() > 0);
+  double vol[3] = { 0, 0, 0 };
+  vtkNew<vtkIdList> ids;
+  for (vtkIdType c = 0; c < out->GetNumberOfCells(); ++c)
+  {
+    const int r = static_cast<int>(region->GetTuple1(c));
+    CHECK(r == 1 || r == 2);
+    if (r != 1 && r != 2)
+      continue;
+    out->GetCellPoints(c, ids);
+    double p[4][3];
+    for (int k = 0; k < 4; ++k)
+      out->GetPoint(ids->GetId(k), p[k]);
+    double u[3], v[3], w[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      u[k] = p[1][k] - p[0][k];
+      v[k] = p[2][k] - p[0][k];
+      w[k] = p[3][k] - p[0][k];
+    }
+    vol[r] += (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0]) +
+                u[2] * (v[0] * w[1] - v[1] * w[0])) /
+      6;
+  }
+  CHECK(std::fabs(vol[1] - 1) < 1e-10 && std::fabs(vol[2] - 1) < 1e-10);
+  CHECK(filter->GetOutput(1)->GetNumberOfCells() == static_cast<vtkIdType>(nt));
+  std::printf("  two regions: %lld tets, volumes %.12f + %.12f\n",
+    static_cast<long long>(out->GetNumberOfCells()), vol[1], vol[2]);
+}
+
 void ExpectFailure(vtkCurveTetFilter* filter, Messages& msgs, const char* needle, const char* what)
 {
   const int before = msgs.errors;
@@ -780,7 +848,7 @@ int main(int argc, char* argv[])
 {
   if (argc < 3)
   {
-    std::fprintf(stderr, "usage: %s pipeline|p2|bad|abort|smooth|thorough FILE [OUTDIR]\n", argv[0]);
+    std::fprintf(stderr, "usage: %s pipeline|p2|regions|bad|abort|smooth|thorough FILE [OUTDIR]\n", argv[0]);
     return 2;
   }
   const std::string mode = argv[1], file = argv[2];
@@ -789,6 +857,8 @@ int main(int argc, char* argv[])
     TestPipeline(file, argv[3]);
   else if (mode == "p2")
     TestP2(file);
+  else if (mode == "regions")
+    TestRegions(file);
   else if (mode == "bad")
     TestBad(file);
   else if (mode == "abort")
