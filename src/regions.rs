@@ -26,12 +26,14 @@
 use crate::front::FrontStats;
 use crate::generate::{generate_with_progress, Generated, StageTimes};
 use crate::geom::P3;
-use crate::io::{Groups, PhysicalName, RawMesh};
+use crate::io::{Groups, PhysicalName, RawMesh, VolumeEntity};
 use crate::mesh::merge::{merge, RegionMesh};
 use crate::mesh::report::QualityReport;
 use crate::mesh::{check, TetMesh};
 use crate::surface::curve::CurveOptions;
-use crate::surface::regions::{has_junction_edges, in_region, region_surface, split_regions};
+use crate::surface::regions::{
+    has_junction_edges, in_region, region_surface, split_regions, RegionBoundary,
+};
 use crate::{Error, Options, Repair, Result, Surface};
 
 /// When a surface is taken as several regions.
@@ -47,6 +49,10 @@ pub enum RegionMode {
     /// nested in another is the boundary of an inner region, not a cavity.
     EveryShell,
 }
+
+/// The warning of a linear surface of several regions.
+pub const FLAT_WARNING: &str = "a linear surface of several regions is not curved: its edges \
+                                stay straight (mid nodes at the edge midpoints)";
 
 /// One region of a [`Regions`] input: its id, name and checked boundary surface.
 #[derive(Debug, Clone)]
@@ -86,6 +92,40 @@ impl Regions {
         tags: Vec<i32>,
         repair: Repair,
     ) -> Result<Regions> {
+        Regions::build(nodes, tris, tags, repair, None)
+    }
+
+    /// [`Regions::new`] with the volume entities of a Gmsh file (`entities`: each
+    /// triangle's surface entity tag): a region whose boundary is on exactly the bounding
+    /// surfaces of a volume entity takes that volume's physical tag as its id (its entity
+    /// tag when it has no single physical tag), and a region no volume entity matches is
+    /// a hole, not meshed (with a warning). When no region matches any volume entity, the
+    /// regions are numbered 1..n (with a warning).
+    pub fn with_volumes(
+        nodes: Vec<P3>,
+        tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        entities: &[i32],
+        volumes: &[VolumeEntity],
+        repair: Repair,
+    ) -> Result<Regions> {
+        if entities.len() != tris.len() {
+            return Err(Error::InvalidArgument(format!(
+                "{} surface entity tags for {} triangles",
+                entities.len(),
+                tris.len()
+            )));
+        }
+        Regions::build(nodes, tris, tags, repair, Some((entities, volumes)))
+    }
+
+    fn build(
+        nodes: Vec<P3>,
+        tris: Vec<[u32; 6]>,
+        tags: Vec<i32>,
+        repair: Repair,
+        gmsh: Option<(&[i32], &[VolumeEntity])>,
+    ) -> Result<Regions> {
         if !tags.is_empty() && tags.len() != tris.len() {
             return Err(Error::InvalidArgument(format!(
                 "{} tags for {} triangles (give one tag per triangle, or none)",
@@ -94,7 +134,11 @@ impl Regions {
             )));
         }
         crate::surface::coords::check_coordinates(&nodes)?;
-        let split = split_regions(&nodes, &tris)?;
+        let mut split = split_regions(&nodes, &tris)?;
+        let mut warnings = Vec::new();
+        if let Some((entities, volumes)) = gmsh {
+            match_volumes(&mut split, entities, volumes, &mut warnings);
+        }
         let untagged = tags.iter().all(|&t| t == 0);
         let mut tags = if tags.is_empty() {
             vec![0; tris.len()]
@@ -132,7 +176,6 @@ impl Regions {
             }
         }
         let mut regions = Vec::with_capacity(split.len());
-        let mut warnings = Vec::new();
         for r in &split {
             let (surface, map) = region_surface(&nodes, &tris, &tags, r, repair)?;
             warnings.extend(
@@ -170,14 +213,7 @@ impl Regions {
     ) -> Result<Regions> {
         let (nodes, tris) = flat_p2(nodes, tri3)?;
         let mut r = Regions::new(nodes, tris, tags, repair)?;
-        r.warnings.insert(
-            0,
-            format!(
-                "a linear surface of {} regions is not curved: its edges stay straight (mid \
-                 nodes at the edge midpoints)",
-                r.regions.len()
-            ),
-        );
+        r.warnings.insert(0, FLAT_WARNING.to_string());
         Ok(r)
     }
 
@@ -229,6 +265,72 @@ impl Regions {
     pub fn tags(&self) -> &[i32] {
         &self.tags
     }
+}
+
+/// Gives each region of `split` the id of the Gmsh volume entity bounded by exactly its
+/// boundary's surface entities, and drops the regions no volume entity matches (holes);
+/// leaves the ids 1..n when none matches (see [`Regions::with_volumes`]).
+fn match_volumes(
+    split: &mut Vec<RegionBoundary>,
+    entities: &[i32],
+    volumes: &[VolumeEntity],
+    warnings: &mut Vec<String>,
+) {
+    let matched: Vec<Option<i32>> = split
+        .iter()
+        .map(|r| {
+            let mut set: Vec<i32> = r
+                .triangles
+                .iter()
+                .map(|&t| entities[t as usize].saturating_abs())
+                .collect();
+            set.sort_unstable();
+            set.dedup();
+            volumes
+                .iter()
+                .find(|v| v.surfaces == set)
+                .map(|v| match v.physical[..] {
+                    [p] if p > 0 => p,
+                    _ => v.tag.max(1),
+                })
+        })
+        .collect();
+    if matched.iter().all(Option::is_none) {
+        warnings.push(format!(
+            "the file's {} volume entities are bounded by none of the {} regions' surfaces: \
+             the regions are numbered 1..{}",
+            volumes.len(),
+            split.len(),
+            split.len()
+        ));
+        return;
+    }
+    let holes: Vec<i32> = split
+        .iter()
+        .zip(&matched)
+        .filter(|(_, m)| m.is_none())
+        .map(|(r, _)| r.id)
+        .collect();
+    if !holes.is_empty() {
+        warnings.push(format!(
+            "{} of {} regions are holes (no volume entity of the file is bounded by their \
+             surfaces): not meshed",
+            holes.len(),
+            split.len()
+        ));
+    }
+    let mut k = 0;
+    split.retain_mut(|r| {
+        let m = matched[k];
+        k += 1;
+        match m {
+            Some(id) => {
+                r.id = id;
+                true
+            }
+            None => false,
+        }
+    });
 }
 
 /// 6-node triangles with straight edges from 3-node ones: one new node at the midpoint
@@ -316,8 +418,29 @@ impl MeshInput {
             return crate::io::surface_from_raw_any(raw, name, curve).map(MeshInput::Surface);
         }
         let groups = raw.groups();
-        let regions = if linear {
+        let regions = if linear && raw.volumes.len() >= 2 {
+            let (nodes, tris) = flat_p2(raw.nodes, &raw.tri3)?;
+            let mut r = Regions::with_volumes(
+                nodes,
+                tris,
+                raw.tri3_tags,
+                &raw.tri3_entities,
+                &raw.volumes,
+                curve.repair,
+            )?;
+            r.warnings.insert(0, FLAT_WARNING.to_string());
+            Ok(r)
+        } else if linear {
             Regions::from_linear(raw.nodes, &raw.tri3, raw.tri3_tags, curve.repair)
+        } else if raw.volumes.len() >= 2 {
+            Regions::with_volumes(
+                raw.nodes,
+                raw.tri6,
+                raw.tri6_tags,
+                &raw.tri6_entities,
+                &raw.volumes,
+                curve.repair,
+            )
         } else {
             Regions::new(raw.nodes, raw.tri6, raw.tri6_tags, curve.repair)
         }
@@ -342,7 +465,8 @@ impl MeshInput {
         } else {
             has_junction_edges(&raw.tri6)
         };
-        if !junctions && mode == RegionMode::Auto {
+        let gmsh_volumes = raw.volumes.len() >= 2;
+        if !junctions && mode == RegionMode::Auto && !gmsh_volumes {
             return false;
         }
         let split = if linear {
@@ -353,6 +477,9 @@ impl MeshInput {
         let Ok(split) = split else {
             return false;
         };
+        if gmsh_volumes {
+            return split.len() > 1;
+        }
         match mode {
             RegionMode::EveryShell => split.len() > 1,
             RegionMode::Auto => {

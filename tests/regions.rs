@@ -223,3 +223,122 @@ fn a_linear_split_box_is_meshed_flat_with_a_warning() {
         assert!((region_volume(&g, r) - 1.0).abs() <= 1e-10);
     }
 }
+
+/// Three spheres (radii 0.4, 0.7, 1) as a Gmsh MSH 4.1 surface file whose entities list two
+/// volumes: "ball" (physical 20, bounded by the inner sphere) and "shell" (physical 10,
+/// bounded by the outer two). The region between the inner two spheres is no volume: a
+/// hole.
+fn three_spheres_msh(volumes: &str) -> (Vec<u8>, [f64; 3]) {
+    use std::fmt::Write;
+    let (v, t) = curvetet::surface::demo::icosphere(1);
+    let radii = [0.4, 0.7, 1.0];
+    let mut nodes = Vec::new();
+    let mut tris: Vec<Vec<[u32; 6]>> = Vec::new();
+    let mut vols = [0.0; 3];
+    for (k, r) in radii.iter().enumerate() {
+        let base = nodes.len() as u32;
+        nodes.extend(v.iter().map(|p| p.map(|x| x * r)));
+        let sphere: Vec<[u32; 6]> = t.iter().map(|x| x.map(|i| i + base)).collect();
+        vols[k] = enclosed_volume_linear(&nodes, &sphere);
+        tris.push(sphere);
+    }
+    let mut s = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n");
+    s += "$PhysicalNames\n2\n3 10 \"shell\"\n3 20 \"ball\"\n$EndPhysicalNames\n";
+    writeln!(s, "$Entities\n0 0 3 {}", volumes.lines().count()).unwrap();
+    for e in 1..=3 {
+        writeln!(s, "{e} -1 -1 -1 1 1 1 0 0").unwrap();
+    }
+    s += volumes;
+    s += "$EndEntities\n$Nodes\n";
+    let n = nodes.len();
+    writeln!(s, "1 {n} 1 {n}\n2 1 0 {n}").unwrap();
+    for i in 1..=n {
+        writeln!(s, "{i}").unwrap();
+    }
+    for p in &nodes {
+        writeln!(s, "{:?} {:?} {:?}", p[0], p[1], p[2]).unwrap();
+    }
+    s += "$EndNodes\n$Elements\n";
+    let m: usize = tris.iter().map(Vec::len).sum();
+    writeln!(s, "3 {m} 1 {m}").unwrap();
+    let mut id = 1;
+    for (e, sphere) in tris.iter().enumerate() {
+        writeln!(s, "2 {} 9 {}", e + 1, sphere.len()).unwrap();
+        for x in sphere {
+            let x: Vec<String> = x.iter().map(|v| (v + 1).to_string()).collect();
+            writeln!(s, "{id} {}", x.join(" ")).unwrap();
+            id += 1;
+        }
+    }
+    s += "$EndElements\n";
+    (s.into_bytes(), vols)
+}
+
+#[test]
+fn gmsh_volumes_number_and_name_the_regions_and_leave_holes_empty() {
+    let (bytes, vols) =
+        three_spheres_msh("1 -1 -1 -1 1 1 1 1 10 2 3 -2\n2 -1 -1 -1 1 1 1 1 20 1 1\n");
+    let raw = io::read_bytes(&bytes, io::Format::Msh, "three.msh").expect("reads");
+    assert_eq!(raw.volumes.len(), 2);
+    assert_eq!(raw.tri6_entities.len(), raw.tri6.len());
+    let input = MeshInput::from_raw(raw, "three.msh", &Default::default(), RegionMode::Auto)
+        .expect("splits");
+    assert_eq!(input.num_regions(), 2);
+    assert!(
+        input
+            .warnings()
+            .iter()
+            .any(|w| w.contains("1 of 3 regions are holes")),
+        "{:?}",
+        input.warnings()
+    );
+    let g = generate_input(&input, &opts(), &mut |_, _| false).expect("meshes");
+    assert_eq!(g.mesh.region_ids(), vec![10, 20]);
+    let ball = region_volume(&g, 20);
+    let shell = region_volume(&g, 10);
+    assert!(
+        (ball - vols[0]).abs() <= 1e-10 * vols[0],
+        "{ball} vs {}",
+        vols[0]
+    );
+    let want = vols[2] - vols[1];
+    assert!((shell - want).abs() <= 1e-10 * want, "{shell} vs {want}");
+    // No interface: the hole separates the regions; every input triangle is a boundary.
+    assert_eq!(assert_conforming(&g), 0);
+    assert_eq!(g.mesh.boundary.len(), 3 * 80);
+    assert_eq!(
+        io::region_names(&g.mesh),
+        vec![(10, "shell".to_string()), (20, "ball".to_string())]
+    );
+    let bytes = io::mesh_to_bytes(&g.mesh, io::Format::Msh, &WriteOptions::default()).unwrap();
+    let back = io::read_bytes(&bytes, io::Format::Msh, "out.msh").unwrap();
+    let mut tags = back.tet10_tags.clone();
+    tags.sort_unstable();
+    tags.dedup();
+    assert_eq!(tags, vec![10, 20]);
+    assert!(back
+        .physical_names
+        .iter()
+        .any(|n| n.dim == 3 && n.tag == 20 && n.name == "ball"));
+}
+
+/// Three volumes in one physical volume: one region id, the surfaces between them interior
+/// faces (not boundary triangles), the whole ball filled.
+#[test]
+fn gmsh_volumes_of_one_physical_volume_are_one_region() {
+    let (bytes, vols) = three_spheres_msh(
+        "1 -1 -1 -1 1 1 1 1 10 2 3 -2\n2 -1 -1 -1 1 1 1 1 10 2 2 -1\n3 -1 -1 -1 1 1 1 1 10 1 1\n",
+    );
+    let raw = io::read_bytes(&bytes, io::Format::Msh, "three.msh").expect("reads");
+    let input = MeshInput::from_raw(raw, "three.msh", &Default::default(), RegionMode::Auto)
+        .expect("splits");
+    assert_eq!(input.num_regions(), 3);
+    assert!(input.warnings().is_empty(), "{:?}", input.warnings());
+    let g = generate_input(&input, &opts(), &mut |_, _| false).expect("meshes");
+    assert_eq!(g.mesh.region_ids(), vec![10]);
+    // Only the outer sphere bounds the mesh.
+    assert_eq!(g.mesh.boundary.len(), 80);
+    assert_eq!(assert_conforming(&g), 0);
+    let v = region_volume(&g, 10);
+    assert!((v - vols[2]).abs() <= 1e-10 * vols[2], "{v} vs {}", vols[2]);
+}

@@ -122,6 +122,26 @@ pub struct RawMesh {
     pub ignored_elements: u64,
     /// Named physical groups (Gmsh `$PhysicalNames`), in file order.
     pub physical_names: Vec<PhysicalName>,
+    /// The volume entities a Gmsh 4.1 surface file lists (`$Entities`), with their
+    /// bounding surfaces: which regions of a surface of several regions to mesh, and
+    /// their numbers ([`crate::MeshInput`]). Empty for other files and for files with
+    /// tetrahedra.
+    pub volumes: Vec<VolumeEntity>,
+    /// With `volumes`: the surface entity tag of each 3-node triangle.
+    pub tri3_entities: Vec<i32>,
+    /// With `volumes`: the surface entity tag of each 6-node triangle.
+    pub tri6_entities: Vec<i32>,
+}
+
+/// A Gmsh volume entity of a surface file (`$Entities` of MSH 4.1).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct VolumeEntity {
+    /// The entity's tag.
+    pub tag: i32,
+    /// Its physical tags (physical volumes it is in).
+    pub physical: Vec<i32>,
+    /// The tags of its bounding surface entities, sorted, without orientation signs.
+    pub surfaces: Vec<i32>,
 }
 
 impl RawMesh {

@@ -58,6 +58,8 @@ pub fn merge(
     let mut boundary = Vec::new();
     let mut boundary_tags = Vec::new();
     let mut source = Vec::new();
+    let mut owner: Vec<i32> = Vec::new();
+    let mut interior: Vec<bool> = Vec::new();
     for r in regions {
         let n_surf = r.map.len();
         let base = nodes.len() as u32;
@@ -74,13 +76,24 @@ pub fn merge(
             tet_regions.push(r.id);
         }
         for (tri, &input) in r.mesh.boundary.iter().zip(r.triangles) {
-            if boundary_of[input as usize] == NONE {
+            let b = boundary_of[input as usize];
+            if b == NONE {
                 boundary_of[input as usize] = boundary.len() as u32;
                 boundary.push(tri.map(to_global));
                 boundary_tags.push(tags.get(input as usize).copied().unwrap_or(0));
                 source.push(input);
+                owner.push(r.id);
+            } else if owner[b as usize] == r.id {
+                // Between two regions of one id (one physical volume): an interior face.
+                interior[b as usize] = true;
             }
         }
+        interior.resize(boundary.len(), false);
+    }
+    if interior.iter().any(|&x| x) {
+        boundary = keep(boundary, &interior);
+        boundary_tags = keep(boundary_tags, &interior);
+        source = keep(source, &interior);
     }
     let mesh = TetMesh {
         nodes,
@@ -91,4 +104,13 @@ pub fn merge(
         tet_regions,
     };
     (mesh, source)
+}
+
+/// The items of `v` whose `drop` flag is false.
+fn keep<T>(v: Vec<T>, drop: &[bool]) -> Vec<T> {
+    v.into_iter()
+        .zip(drop)
+        .filter(|(_, &d)| !d)
+        .map(|(x, _)| x)
+        .collect()
 }

@@ -95,6 +95,8 @@ struct Reader<'a> {
     blocks: Vec<Block>,
     /// (dim, entity tag) -> the entity's physical tag, for entities with exactly one.
     physical: HashMap<(i32, i32), i32>,
+    /// The volume entities of `$Entities` (4.1).
+    volumes: Vec<crate::io::VolumeEntity>,
 }
 
 /// Read a .msh file held in `data`; `name` is used in error locations.
@@ -158,6 +160,7 @@ pub(crate) fn read(data: &[u8], name: &str) -> Result<RawMesh> {
         seen_elements: false,
         blocks: Vec::new(),
         physical: HashMap::new(),
+        volumes: Vec::new(),
     };
     r.sections()?;
     r.finish()
@@ -300,6 +303,21 @@ impl<'a> Reader<'a> {
                 Kind::Tet10 => &mut self.mesh.tet10_tags,
             };
             tags[b.start..b.end].fill(tag);
+        }
+        // A surface file whose entities list volumes: which surface entity each triangle
+        // is on, for the regions (a file with tetrahedra is a mesh already).
+        let m = &mut self.mesh;
+        if !self.volumes.is_empty() && m.tet4.is_empty() && m.tet10.is_empty() {
+            m.tri3_entities = vec![0; m.tri3.len()];
+            m.tri6_entities = vec![0; m.tri6.len()];
+            for b in &self.blocks {
+                match b.kind {
+                    Kind::Tri3 => m.tri3_entities[b.start..b.end].fill(b.entity),
+                    Kind::Tri6 => m.tri6_entities[b.start..b.end].fill(b.entity),
+                    _ => {}
+                }
+            }
+            m.volumes = std::mem::take(&mut self.volumes);
         }
         Ok(self.mesh)
     }

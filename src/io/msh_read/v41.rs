@@ -4,6 +4,21 @@
 
 use super::{capped, Block, Reader};
 use crate::error::Result;
+use crate::io::VolumeEntity;
+
+/// A volume entity with its bounding surfaces (orientation signs dropped, sorted).
+fn volume_entity(tag: i32, physical: Vec<i32>, mut surfaces: Vec<i32>) -> VolumeEntity {
+    for s in surfaces.iter_mut() {
+        *s = s.saturating_abs();
+    }
+    surfaces.sort_unstable();
+    surfaces.dedup();
+    VolumeEntity {
+        tag,
+        physical,
+        surfaces,
+    }
+}
 
 impl Reader<'_> {
     pub(super) fn entities_ascii(&mut self) -> Result<()> {
@@ -23,20 +38,21 @@ impl Reader<'_> {
                     c.f64("entity bounding box")?;
                 }
                 let nphys = c.count("number of physical tags", max)?;
-                let mut first = 0;
-                for k in 0..nphys {
-                    let p = c.i32("physical tag")?;
-                    if k == 0 {
-                        first = p;
-                    }
+                let mut physical = Vec::new();
+                for _ in 0..nphys {
+                    physical.push(c.i32("physical tag")?);
                 }
                 if nphys == 1 {
-                    self.physical.insert((dim as i32, tag), first);
+                    self.physical.insert((dim as i32, tag), physical[0]);
                 }
                 if dim > 0 {
                     let nb = c.count("number of bounding entities", max)?;
+                    let mut surfaces = Vec::new();
                     for _ in 0..nb {
-                        c.i32("bounding entity tag")?;
+                        surfaces.push(c.i32("bounding entity tag")?);
+                    }
+                    if dim == 3 {
+                        self.volumes.push(volume_entity(tag, physical, surfaces));
                     }
                 }
             }
@@ -59,20 +75,23 @@ impl Reader<'_> {
                 c.bytes(8 * nbox, "entity bounding box")?;
                 let nphys = c.bin_usize(ds, "number of physical tags")?;
                 c.need(nphys, 4, "physical tags")?;
-                let mut first = 0;
-                for k in 0..nphys {
-                    let p = c.bin_i32("physical tag")?;
-                    if k == 0 {
-                        first = p;
-                    }
+                let mut physical = Vec::new();
+                for _ in 0..nphys {
+                    physical.push(c.bin_i32("physical tag")?);
                 }
                 if nphys == 1 {
-                    self.physical.insert((dim as i32, tag), first);
+                    self.physical.insert((dim as i32, tag), physical[0]);
                 }
                 if dim > 0 {
                     let nb = c.bin_usize(ds, "number of bounding entities")?;
                     c.need(nb, 4, "bounding entity tags")?;
-                    c.bytes(4 * nb as usize, "bounding entity tags")?;
+                    let mut surfaces = Vec::new();
+                    for _ in 0..nb {
+                        surfaces.push(c.bin_i32("bounding entity tag")?);
+                    }
+                    if dim == 3 {
+                        self.volumes.push(volume_entity(tag, physical, surfaces));
+                    }
                 }
             }
         }
