@@ -530,11 +530,14 @@ fn run_mesh(
         r.quality.min_dihedral.min,
         r.quality.max_dihedral.max,
     );
-    let names = io::region_names(&g.mesh);
-    for (x, (_, name)) in g.regions.iter().zip(&names) {
+    for x in &g.regions {
         eprintln!(
-            "  region {} ({name}): {} tets, volume {:.9}, min scaled Jacobian {:.3}",
-            x.id, x.report.num_tets, x.report.volume_curved, x.report.quality.scaled_jacobian.min
+            "  region {} ({}): {} tets, volume {:.9}, min scaled Jacobian {:.3}",
+            x.id,
+            x.name,
+            x.report.num_tets,
+            x.report.volume_curved,
+            x.report.quality.scaled_jacobian.min
         );
     }
     eprintln!("wrote {}", output.display());
