@@ -16,11 +16,14 @@ mid nodes of (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)); ``Mesh.tets_vtk`` is in 
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import json
 import os
+import signal
+import threading
 import weakref
-from typing import Any, Callable, Optional, Union
+from typing import Any, Callable, Iterator, Optional, Union
 
 import numpy as np
 
@@ -277,23 +280,47 @@ def from_meshio(m: Any, *, feature_angle: float = 40.0) -> Surface:
 
 class _Progress:
     """The C progress callback: calls the user's function, catches every Python exception
-    (none may cross the C frames) and cancels; ``reraise`` raises it after generate."""
+    (none may cross the C frames) and cancels; ``mesh`` raises it after generate.
+
+    Ctrl-C: Python raises KeyboardInterrupt from its SIGINT handler at the next Python
+    code it runs, which may be the entry of this callback, before any ``try`` (ctypes would
+    then print and ignore it). So while generate runs, ``sigint_guard`` replaces Python's
+    default SIGINT handler by one that only records the signal; the callback cancels on
+    it and ``mesh`` raises KeyboardInterrupt once generate has returned."""
 
     def __init__(self, fn: Optional[ProgressFn]) -> None:
         self.fn = fn
         self.error: Optional[BaseException] = None
-        self.cancelled_by_user = False
+        self.interrupted = False
         self.c_fn = _lib.PROGRESS_FN(self._call)
 
     def _call(self, _user: Any, fraction: float, stage: bytes) -> int:
         try:
+            if self.interrupted:
+                return 1
             if self.fn is not None and self.fn(fraction, stage.decode(errors="replace")) is False:
-                self.cancelled_by_user = True
                 return 1
             return 0
         except BaseException as e:  # noqa: B036 - KeyboardInterrupt included, on purpose
             self.error = e
             return 1
+
+    def _on_sigint(self, _signum: int, _frame: Any) -> None:
+        self.interrupted = True
+
+    @contextlib.contextmanager
+    def sigint_guard(self) -> Iterator[None]:
+        """Record SIGINT instead of raising, when Python's default handler is installed
+        and this is the main thread (a program's own handler is left alone)."""
+        if (threading.current_thread() is not threading.main_thread()
+                or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+            yield
+            return
+        signal.signal(signal.SIGINT, self._on_sigint)
+        try:
+            yield
+        finally:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _tqdm_progress() -> tuple[ProgressFn, Callable[[], None]]:
@@ -360,13 +387,18 @@ def mesh(points: Union[Any, Surface], triangles: Any = None, *, tags: Any = None
     opt.progress = cb.c_fn
     out = ctypes.c_void_p()
     try:
-        code = _lib.load().curvetet_generate(surf._handle, ctypes.byref(opt), ctypes.byref(out))
+        with cb.sigint_guard():
+            code = _lib.load().curvetet_generate(surf._handle, ctypes.byref(opt),
+                                                 ctypes.byref(out))
     finally:
         if close is not None:
             close()
-    if cb.error is not None:
+    error = cb.error
+    if error is None and cb.interrupted:
+        error = KeyboardInterrupt()
+    if error is not None:
         if out:
             _lib.load().curvetet_mesh_free(out)
-        raise cb.error
+        raise error
     _check(code)
     return Mesh(out)

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import importlib
+import importlib.util
 import math
 import os
+import signal
 
 import numpy as np
 import pytest
@@ -11,6 +14,14 @@ import pytest
 import curvetet
 
 SPHERE_VOLUME = 4.0 / 3.0 * math.pi
+
+
+def optional(module: str):
+    """An optional extra (meshio, pyvista, tqdm): skipped when missing, except under
+    CURVETET_REQUIRE_TOOLS=1 (scripts/python-test installs them all: none may skip)."""
+    if os.environ.get("CURVETET_REQUIRE_TOOLS") == "1":
+        return importlib.import_module(module)
+    return pytest.importorskip(module)
 
 
 def icosphere(level: int = 2) -> tuple[np.ndarray, np.ndarray]:
@@ -113,10 +124,10 @@ def test_write_and_read_back(sphere, tmp_path, ext):
     want = np.unique(m.nodes[np.unique(m.boundary_faces)], axis=0)
     got = np.unique(s.nodes[np.unique(s.triangles)], axis=0)
     assert got.shape == want.shape and np.allclose(got, want, rtol=0, atol=1e-12)
-    try:
-        import meshio
-    except ImportError:  # the file was checked above; meshio is an optional extra
+    # The file was checked above; meshio (an optional extra) reads it too.
+    if os.environ.get("CURVETET_REQUIRE_TOOLS") != "1" and importlib.util.find_spec("meshio") is None:
         return
+    import meshio
     if ext == ".mesh":
         # meshio's medit reader has no P2 sections (TetrahedraP2): check the linear variant.
         path = tmp_path / "sphere_linear.mesh"
@@ -151,7 +162,7 @@ def test_write_errors(sphere, tmp_path):
 
 
 def test_meshio_round_trip(sphere, tmp_path):
-    meshio = pytest.importorskip("meshio")
+    meshio = optional("meshio")
     _, tris, m = sphere
     mm = m.to_meshio()
     assert mm.get_cells_type("tetra10").shape == (len(m.tets), 10)
@@ -242,8 +253,39 @@ def test_bad_shapes():
 
 
 def test_to_pyvista(sphere):
-    pyvista = pytest.importorskip("pyvista")
+    pyvista = optional("pyvista")
     _, _, m = sphere
     grid = m.to_pyvista()
     assert grid.n_cells == len(m.tets)
     assert set(np.unique(grid.celltypes)) == {pyvista.CellType.QUADRATIC_TETRA}
+
+
+def test_tqdm_progress(capsys):
+    optional("tqdm")
+    points, tris = icosphere(1)
+    m = curvetet.mesh(points, tris, threads=2, progress=True)
+    assert len(m.tets) > 0
+    err = capsys.readouterr().err
+    assert "front" in err and "certify" in err
+
+
+def test_ctrl_c_cancels():
+    """A real SIGINT (Ctrl-C) during generate cancels it and raises KeyboardInterrupt."""
+    points, tris = icosphere(1)
+    calls = []
+
+    def send_sigint_once(f: float, s: str) -> None:
+        calls.append(s)
+        if len(calls) == 1:
+            signal.raise_signal(signal.SIGINT)
+
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            curvetet.mesh(points, tris, threads=2, progress=send_sigint_once)
+        # Cancelled at the next callback: the front had just started.
+        assert calls == ["front"], calls
+        # Python's handler is back.
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    finally:
+        signal.signal(signal.SIGINT, old)
