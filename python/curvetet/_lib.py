@@ -1,6 +1,7 @@
 """ctypes declarations of the curvetet C ABI (include/curvetet.h) and the library loader.
 
-This is the one place in the Python package that mirrors the C structs: ``Options`` is
+This is the one place that mirrors the C structs in Python (the Gmsh wrapper,
+bindings/gmsh/curvetet_gmsh.py, loads this file too): ``Options`` is
 ``struct curvetet_options`` and ``Quality`` is ``struct curvetet_quality``, field by field
 in the header's order. ``load()`` checks the mirror against the library at load time (the
 ``struct_size`` that ``curvetet_options_default`` writes must equal ``ctypes.sizeof``), so a
@@ -13,6 +14,9 @@ import ctypes
 import glob
 import os
 from typing import Optional
+
+# No import of numpy or of the package here: the Gmsh wrapper loads this file on its own,
+# in a Python that may have neither.
 
 # Status codes (enum curvetet_status).
 OK = 0
@@ -83,7 +87,9 @@ def _candidates() -> list[str]:
     return found + ([env] if env else [])
 
 
-def _declare(lib: ctypes.CDLL) -> None:
+def declare(lib: ctypes.CDLL) -> None:
+    """Set the argument and result types of the C ABI's functions on ``lib`` (also used by
+    bindings/gmsh/curvetet_gmsh.py, which loads the library its own way)."""
     c = ctypes
     dp, up, ip = c.POINTER(c.c_double), c.POINTER(c.c_uint32), c.POINTER(c.c_int32)
     vp, vpp = c.c_void_p, c.POINTER(c.c_void_p)
@@ -92,6 +98,7 @@ def _declare(lib: ctypes.CDLL) -> None:
         "curvetet_last_error_message": (c.c_char_p, []),
         "curvetet_error_name": (c.c_char_p, [c.c_int]),
         "curvetet_options_default": (None, [c.POINTER(Options)]),
+        "curvetet_options_init": (c.c_int, [c.POINTER(Options), c.c_size_t]),
         "curvetet_generate": (c.c_int, [vp, c.POINTER(Options), vpp]),
         "curvetet_mesh_free": (None, [vp]),
         "curvetet_mesh_num_nodes": (c.c_size_t, [vp]),
@@ -148,7 +155,7 @@ def load() -> ctypes.CDLL:
         except OSError as e:
             tried.append("%s (%s)" % (path, e))
             continue
-        _declare(lib)
+        declare(lib)
         _check_layout(lib)
         _lib, _lib_path = lib, path
         return lib
