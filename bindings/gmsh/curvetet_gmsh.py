@@ -13,12 +13,15 @@ have. curvetet is called through its C ABI (libcurvetet, include/curvetet.h) wit
 the library is found through, in order: the CURVETET_LIBRARY environment variable (the
 library file), the install prefix this module was installed into
 (<prefix>/share/curvetet/python -> <prefix>/lib*), the repository's cargo build
-(target/release, or $CARGO_TARGET_DIR/release), then the system's library path.
+(target/release, or $CARGO_TARGET_DIR/release), then the system's library path. The
+ctypes declarations (struct curvetet_options and the signatures) are the curvetet Python
+package's (python/curvetet/_lib.py; see _load_ctypes_mirror).
 """
 
 import ctypes
 import ctypes.util
 import glob
+import importlib.util
 import os
 import re
 
@@ -37,24 +40,32 @@ class CurvetetError(RuntimeError):
 
 # --- the C library -------------------------------------------------------------------
 
-_PROGRESS = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.c_char_p)
+def _load_ctypes_mirror():
+    """The curvetet Python package's ``_lib`` module (python/curvetet/_lib.py): the one
+    ctypes mirror of struct curvetet_options and of the C ABI's signatures. Loaded by file,
+    not imported as ``curvetet._lib`` (the package's ``__init__`` needs numpy, which this
+    module does not), from, in order: a copy installed beside this module
+    (<prefix>/share/curvetet/python/curvetet_lib.py, by CMake), the repository's
+    python/curvetet/_lib.py, an installed ``curvetet`` package (pip)."""
+    here = os.path.dirname(os.path.realpath(__file__))
+    paths = [os.path.join(here, "curvetet_lib.py"),
+             os.path.join(here, "..", "..", "python", "curvetet", "_lib.py")]
+    spec = importlib.util.find_spec("curvetet")  # finds the package without importing it
+    if spec is not None and spec.submodule_search_locations:
+        paths += [os.path.join(p, "_lib.py") for p in spec.submodule_search_locations]
+    for path in paths:
+        if os.path.exists(path):
+            spec = importlib.util.spec_from_file_location("curvetet_gmsh_lib", path)
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            return module
+    raise ImportError("curvetet_gmsh: cannot find curvetet's ctypes declarations (tried: %s)"
+                      % ", ".join(paths))
 
 
-class _Options(ctypes.Structure):
-    """struct curvetet_options (include/curvetet.h)."""
-
-    _fields_ = [
-        ("struct_size", ctypes.c_uint32),
-        ("alpha", ctypes.c_double),
-        ("size", ctypes.c_double),
-        ("optimize", ctypes.c_int32),
-        ("threads", ctypes.c_uint32),
-        ("progress", _PROGRESS),
-        ("user_data", ctypes.c_void_p),
-        ("uniform_size", ctypes.c_int32),
-        ("thorough", ctypes.c_int32),
-        ("pin_threads", ctypes.c_int32),
-    ]
+_ctypes_mirror = _load_ctypes_mirror()
+_PROGRESS = _ctypes_mirror.PROGRESS_FN
+_Options = _ctypes_mirror.Options
 
 
 _lib = None
@@ -105,25 +116,7 @@ def _load():
 
 
 def _declare(lib):
-    c = ctypes
-    lib.curvetet_version.restype = c.c_char_p
-    lib.curvetet_last_error_message.restype = c.c_char_p
-    lib.curvetet_error_name.restype = c.c_char_p
-    lib.curvetet_error_name.argtypes = [c.c_int]
-    lib.curvetet_options_init.argtypes = [c.POINTER(_Options), c.c_size_t]
-    lib.curvetet_surface_from_arrays.argtypes = [
-        c.POINTER(c.c_double), c.c_size_t, c.POINTER(c.c_uint32), c.c_size_t,
-        c.POINTER(c.c_int32), c.POINTER(c.c_void_p)]
-    lib.curvetet_surface_free.argtypes = [c.c_void_p]
-    lib.curvetet_generate.argtypes = [c.c_void_p, c.POINTER(_Options), c.POINTER(c.c_void_p)]
-    lib.curvetet_mesh_free.argtypes = [c.c_void_p]
-    lib.curvetet_mesh_num_nodes.argtypes = [c.c_void_p]
-    lib.curvetet_mesh_num_nodes.restype = c.c_size_t
-    lib.curvetet_mesh_nodes.argtypes = [c.c_void_p]
-    lib.curvetet_mesh_nodes.restype = c.POINTER(c.c_double)
-    lib.curvetet_mesh_num_tets.argtypes = [c.c_void_p]
-    lib.curvetet_mesh_num_tets.restype = c.c_size_t
-    lib.curvetet_mesh_tets.argtypes = [c.c_void_p, c.c_int, c.POINTER(c.c_uint32)]
+    _ctypes_mirror.declare(lib)
 
 
 def library_path():

@@ -3,7 +3,8 @@
 # with the installed curvetet_gmsh.py (which finds the installed library by itself).
 #   cmake -DSOURCE=... -DWORK=... -DPREFIX=... -DLIBDIR=... -DGENERATOR=... -DCXX_COMPILER=...
 #         -DPYTHON=... -P run_consumer.cmake
-foreach(f "${LIBDIR}/libcurvetet_gmsh.so" "include/curvetet_gmsh.hpp" "share/curvetet/python/curvetet_gmsh.py")
+foreach(f "${LIBDIR}/libcurvetet_gmsh.so" "include/curvetet_gmsh.hpp" "share/curvetet/python/curvetet_gmsh.py"
+        "share/curvetet/python/curvetet_lib.py")
   if(NOT EXISTS "${PREFIX}/${f}")
     message(FATAL_ERROR "install lacks ${f}")
   endif()
