@@ -8,6 +8,10 @@ inside this package). Arrays go in and come out as numpy arrays::
     m.nodes, m.tets, m.boundary_faces, m.quality
     m.write("part.vtu")
 
+A surface may bound several regions (materials sharing interfaces, each interface triangle
+given once; or, with ``nested_regions=True``, closed shells nested in one another): the
+mesh is then one conforming mesh with a region id per tet (``Mesh.tet_regions``).
+
 Node orders: a 6-node triangle is its corners, then the mid nodes of edges (0,1), (1,2),
 (2,0) (Gmsh's and VTK's order). ``Mesh.tets`` is in Gmsh's order (element type 11: corners,
 mid nodes of (0,1), (1,2), (2,0), (3,0), (3,2), (3,1)); ``Mesh.tets_vtk`` is in VTK's order
@@ -84,17 +88,20 @@ def _index_array(a: Any, what: str) -> np.ndarray:
 
 class Surface:
     """A closed quadratic (6-node) triangle surface, checked by the library (closed,
-    manifold, oriented, not self-intersecting). Build it with :func:`surface`,
-    :func:`read` or :func:`from_meshio`.
+    manifold, oriented, not self-intersecting), or a surface of several regions (each
+    region's boundary checked). Build it with :func:`surface`, :func:`read` or
+    :func:`from_meshio`.
 
     ``nodes`` is (N, 3) float64, ``triangles`` (M, 6) int64 (outward, after any flip the
     check made), ``tags`` (M,) int32, ``warnings`` the check's warnings (e.g. a flipped
-    orientation)."""
+    orientation), ``num_regions`` the number of regions it bounds (1 for a closed surface,
+    with or without cavities)."""
 
     nodes: np.ndarray
     triangles: np.ndarray
     tags: np.ndarray
     warnings: list[str]
+    num_regions: int
 
     def __init__(self, handle: ctypes.c_void_p) -> None:
         """Wrap a ``curvetet_surface *`` (owned from now on); use the factories instead."""
@@ -114,14 +121,16 @@ class Surface:
             lib.curvetet_surface_warning(handle, i).decode(errors="replace")
             for i in range(lib.curvetet_surface_num_warnings(handle))
         ]
+        self.num_regions = int(lib.curvetet_surface_num_regions(handle))
 
     def __repr__(self) -> str:
-        return "<curvetet.Surface: %d nodes, %d triangles>" % (
-            len(self.nodes), len(self.triangles))
+        return "<curvetet.Surface: %d nodes, %d triangles, %d region%s>" % (
+            len(self.nodes), len(self.triangles), self.num_regions,
+            "" if self.num_regions == 1 else "s")
 
 
 def surface(points: Any, triangles: Any, tags: Any = None, *,
-            feature_angle: float = 40.0) -> Surface:
+            feature_angle: float = 40.0, nested_regions: bool = False) -> Surface:
     """A checked :class:`Surface` from arrays.
 
     ``points``: (N, 3) coordinates. ``triangles``: (M, 6) node indices (P2, Gmsh order,
@@ -129,7 +138,14 @@ def surface(points: Any, triangles: Any, tags: Any = None, *,
     points; edges sharper than ``feature_angle`` degrees stay sharp). ``tags``: (M,)
     integers kept on the mesh boundary, or None for all 0. Raises :class:`CurvetetError`
     (status ``CURVETET_ERR_INVALID_SURFACE``) when the surface is not closed, not manifold,
-    self-intersecting, ..., the message naming the check and the element."""
+    self-intersecting, ..., the message naming the check and the element.
+
+    Several regions (P2 triangles only; the linear path takes one closed surface): triangles
+    that bound several regions sharing interfaces (each interface triangle once, so edges
+    where an interface meets the outer boundary have three or more triangles) make a
+    surface of several regions. A closed shell nested in another is a cavity, unless
+    ``nested_regions`` is True: then it bounds an inner region, meshed too
+    (``CURVETET_SURFACE_NESTED_REGIONS``)."""
     lib = _lib.load()
     xyz = np.ascontiguousarray(points, dtype=np.float64)
     if xyz.ndim != 2 or xyz.shape[1] != 3:
@@ -145,10 +161,15 @@ def surface(points: Any, triangles: Any, tags: Any = None, *,
         tag_ptr = _ptr(tag_arr, ctypes.c_int32)
     out = ctypes.c_void_p()
     if tri.shape[1] == 6:
-        code = lib.curvetet_surface_from_arrays(
+        flags = _lib.SURFACE_NESTED_REGIONS if nested_regions else 0
+        code = lib.curvetet_surface_from_arrays_with_flags(
             _ptr(xyz, ctypes.c_double), len(xyz), _ptr(tri, ctypes.c_uint32), len(tri),
-            tag_ptr, ctypes.byref(out))
+            tag_ptr, flags, ctypes.byref(out))
     else:
+        if nested_regions:
+            raise ValueError("nested_regions needs quadratic (M, 6) triangles: linear "
+                             "triangles are curved as one closed surface (curvetet.read "
+                             "takes a linear file of several regions, uncurved)")
         code = lib.curvetet_surface_from_linear(
             _ptr(xyz, ctypes.c_double), len(xyz), _ptr(tri, ctypes.c_uint32), len(tri),
             tag_ptr, float(feature_angle), ctypes.byref(out))
@@ -156,12 +177,18 @@ def surface(points: Any, triangles: Any, tags: Any = None, *,
     return Surface(out)
 
 
-def read(path: Union[str, os.PathLike]) -> Surface:
+def read(path: Union[str, os.PathLike], *, nested_regions: bool = False) -> Surface:
     """Read a surface file by its extension: P2 from Gmsh ``.msh``, ``.vtu``, ``.vtk``,
     medit ``.mesh``; linear from ``.stl``, ``.off``, ``.obj``, ``.ply`` (curved by the
-    library). Raises :class:`CurvetetError` (IO, PARSE with file:line, INVALID_SURFACE)."""
+    library). A file of several regions (interfaces shared; or a Gmsh MSH 4.1 surface
+    whose entities list several volumes) gives a surface of several regions; with
+    ``nested_regions`` a closed shell nested in another bounds an inner region instead of
+    a cavity (see :func:`surface`). Raises :class:`CurvetetError` (IO, PARSE with
+    file:line, INVALID_SURFACE)."""
     out = ctypes.c_void_p()
-    _check(_lib.load().curvetet_surface_read(os.fsencode(path), ctypes.byref(out)))
+    flags = _lib.SURFACE_NESTED_REGIONS if nested_regions else 0
+    _check(_lib.load().curvetet_surface_read_with_flags(os.fsencode(path), flags,
+                                                        ctypes.byref(out)))
     return Surface(out)
 
 
@@ -172,7 +199,11 @@ class Mesh:
     - ``tets``: (T, 10) int64, Gmsh order (element type 11); ``tets_vtk`` the VTK order.
       Positively oriented.
     - ``boundary_faces``: (B, 6) int64, the input surface's triangles (outward), with their
-      tags in ``boundary_tags`` (B,) int32.
+      tags in ``boundary_tags`` (B,) int32. With several regions, each interface triangle
+      is there once.
+    - ``tet_regions``: (T,) int32, the region id of each tet (positive: 1..n for a surface
+      of several regions, the physical volume numbers of the written files; the volume's
+      physical tag, usually 1, for one region); ``num_regions`` the number of distinct ids.
     - ``quality``: summary dict (``curvetet_mesh_quality``); ``scaled_jacobian`` and
       ``skewness``: per-tet (T,) arrays in the order of ``tets``.
     - ``report``: the library's full JSON report as a dict; ``target_size``.
@@ -197,6 +228,10 @@ class Mesh:
                                                 _ptr(tags, ctypes.c_int32)))
         self.boundary_faces: np.ndarray = faces.astype(np.int64)
         self.boundary_tags: np.ndarray = tags
+        regions = np.empty(t, dtype=np.int32)
+        _check(lib.curvetet_mesh_tet_regions(handle, _ptr(regions, ctypes.c_int32)))
+        self.tet_regions: np.ndarray = regions
+        self.num_regions: int = int(lib.curvetet_mesh_num_regions(handle))
         q = _lib.Quality()
         q.struct_size = ctypes.sizeof(_lib.Quality)
         _check(lib.curvetet_mesh_quality(handle, ctypes.byref(q)))
@@ -232,39 +267,46 @@ class Mesh:
 
     def to_meshio(self) -> Any:
         """A ``meshio.Mesh``: ``tetra10`` and ``triangle6`` cells, with cell data
-        ``boundary_tag`` (0 on tets) and ``scaled_jacobian`` (NaN on triangles)."""
+        ``boundary_tag`` (0 on tets), ``region`` (the tets' region ids, 0 on triangles)
+        and ``scaled_jacobian`` (NaN on triangles)."""
         import meshio
 
-        nb = len(self.boundary_faces)
+        nt, nb = len(self.tets), len(self.boundary_faces)
         return meshio.Mesh(
             self.nodes,
             [("tetra10", self.tets_vtk), ("triangle6", self.boundary_faces)],
             cell_data={
-                "boundary_tag": [np.zeros(len(self.tets), dtype=np.int32), self.boundary_tags],
+                "boundary_tag": [np.zeros(nt, dtype=np.int32), self.boundary_tags],
+                "region": [self.tet_regions, np.zeros(nb, dtype=np.int32)],
                 "scaled_jacobian": [self.scaled_jacobian, np.full(nb, np.nan)],
             },
         )
 
     def to_pyvista(self) -> Any:
         """A ``pyvista.UnstructuredGrid`` of quadratic tetra (VTK cell type 24) with cell
-        arrays ``scaled_jacobian`` and ``skewness``. Needs pyvista (ImportError otherwise)."""
+        arrays ``Region`` (the region ids, as the VTK filter names them),
+        ``scaled_jacobian`` and ``skewness``. Needs pyvista (ImportError otherwise)."""
         import pyvista
 
         grid = pyvista.UnstructuredGrid({pyvista.CellType.QUADRATIC_TETRA: self.tets_vtk},
                                         self.nodes)
+        grid.cell_data["Region"] = self.tet_regions
         grid.cell_data["scaled_jacobian"] = self.scaled_jacobian
         grid.cell_data["skewness"] = self.skewness
         return grid
 
     def __repr__(self) -> str:
-        return "<curvetet.Mesh: %d nodes, %d tets, %d boundary faces>" % (
-            len(self.nodes), len(self.tets), len(self.boundary_faces))
+        return "<curvetet.Mesh: %d nodes, %d tets, %d boundary faces, %d region%s>" % (
+            len(self.nodes), len(self.tets), len(self.boundary_faces), self.num_regions,
+            "" if self.num_regions == 1 else "s")
 
 
-def from_meshio(m: Any, *, feature_angle: float = 40.0) -> Surface:
+def from_meshio(m: Any, *, feature_angle: float = 40.0,
+                nested_regions: bool = False) -> Surface:
     """A :class:`Surface` from a ``meshio.Mesh`` with ``triangle6`` cells (P2) or, failing
     that, ``triangle`` cells (linear, curved by the library). The cell data
-    ``gmsh:physical`` becomes the tags when present."""
+    ``gmsh:physical`` becomes the tags when present. ``nested_regions`` as in
+    :func:`surface` (P2 only)."""
     for kind in ("triangle6", "triangle"):
         blocks = [i for i, c in enumerate(m.cells) if c.type == kind]
         if blocks:
@@ -273,7 +315,8 @@ def from_meshio(m: Any, *, feature_angle: float = 40.0) -> Surface:
             phys = m.cell_data.get("gmsh:physical")
             if phys is not None:
                 tags = np.concatenate([np.asarray(phys[i]) for i in blocks])
-            return surface(np.asarray(m.points)[:, :3], tri, tags, feature_angle=feature_angle)
+            return surface(np.asarray(m.points)[:, :3], tri, tags, feature_angle=feature_angle,
+                           nested_regions=nested_regions)
     raise ValueError("the meshio mesh has no triangle6 or triangle cells (cells: %s)"
                      % ", ".join(c.type for c in m.cells))
 
@@ -340,11 +383,15 @@ def _tqdm_progress() -> tuple[ProgressFn, Callable[[], None]]:
 def mesh(points: Union[Any, Surface], triangles: Any = None, *, tags: Any = None,
          size: Optional[float] = None, alpha: float = 1.5, optimize: bool = True,
          threads: int = 0, uniform_size: bool = False, thorough: bool = False,
+         nested_regions: bool = False,
          progress: Union[ProgressFn, bool, None] = None) -> Mesh:
     """Mesh a closed surface into certified quadratic (10-node) tetrahedra.
 
-    ``points``/``triangles``/``tags`` as in :func:`surface` (P2 (M, 6) or linear (M, 3)
-    triangles), or ``points`` a :class:`Surface` (then ``triangles`` is None).
+    ``points``/``triangles``/``tags``/``nested_regions`` as in :func:`surface` (P2 (M, 6)
+    or linear (M, 3) triangles), or ``points`` a :class:`Surface` (then ``triangles`` is
+    None and ``nested_regions`` is given to :func:`surface` or :func:`read` instead). A
+    surface of several regions gives one conforming mesh with a region id per tet
+    (``Mesh.tet_regions``): each region is meshed on its own boundary, kept exactly.
 
     Options: ``size`` the target edge length (None: graded from the surface's triangle
     sizes, or uniform from the mean triangle area with ``uniform_size``); ``alpha`` the
@@ -361,11 +408,14 @@ def mesh(points: Union[Any, Surface], triangles: Any = None, *, tags: Any = None
     if isinstance(points, Surface):
         if triangles is not None or tags is not None:
             raise ValueError("pass either a Surface or points and triangles, not both")
+        if nested_regions:
+            raise ValueError("nested_regions is decided when the Surface is built: pass it "
+                             "to curvetet.surface() or curvetet.read()")
         surf = points
     else:
         if triangles is None:
             raise ValueError("triangles are required with points")
-        surf = surface(points, triangles, tags)
+        surf = surface(points, triangles, tags, nested_regions=nested_regions)
     opt = _lib.default_options()
     if size is not None:
         opt.size = float(size)

@@ -34,6 +34,10 @@ WRITE_BINARY = 1
 WRITE_MSH22 = 2
 WRITE_MEDIT_LINEAR = 4
 
+# Flags of the curvetet_surface_*_with_flags functions.
+SURFACE_STRICT = 1
+SURFACE_NESTED_REGIONS = 2  # not taken by curvetet_surface_from_linear_with_flags
+
 # enum curvetet_node_order.
 ORDER_GMSH = 0
 ORDER_VTK = 1
@@ -105,6 +109,8 @@ def declare(lib: ctypes.CDLL) -> None:
         "curvetet_mesh_nodes": (dp, [vp]),
         "curvetet_mesh_num_tets": (c.c_size_t, [vp]),
         "curvetet_mesh_tets": (c.c_int, [vp, c.c_int, up]),
+        "curvetet_mesh_num_regions": (c.c_size_t, [vp]),
+        "curvetet_mesh_tet_regions": (c.c_int, [vp, ip]),
         "curvetet_mesh_num_boundary_faces": (c.c_size_t, [vp]),
         "curvetet_mesh_boundary_faces": (c.c_int, [vp, up, ip]),
         "curvetet_mesh_quality": (c.c_int, [vp, c.POINTER(Quality)]),
@@ -114,14 +120,21 @@ def declare(lib: ctypes.CDLL) -> None:
         "curvetet_mesh_report_json": (c.c_char_p, [vp]),
         "curvetet_mesh_target_size": (c.c_double, [vp]),
         "curvetet_surface_from_arrays": (c.c_int, [dp, c.c_size_t, up, c.c_size_t, ip, vpp]),
+        "curvetet_surface_from_arrays_with_flags": (
+            c.c_int, [dp, c.c_size_t, up, c.c_size_t, ip, c.c_uint32, vpp]),
         "curvetet_surface_from_linear": (
             c.c_int, [dp, c.c_size_t, up, c.c_size_t, ip, c.c_double, vpp]),
+        "curvetet_surface_from_linear_with_flags": (
+            c.c_int, [dp, c.c_size_t, up, c.c_size_t, ip, c.c_double, c.c_uint32, c.c_uint32,
+                      vpp]),
         "curvetet_surface_read": (c.c_int, [c.c_char_p, vpp]),
+        "curvetet_surface_read_with_flags": (c.c_int, [c.c_char_p, c.c_uint32, vpp]),
         "curvetet_surface_free": (None, [vp]),
         "curvetet_surface_num_nodes": (c.c_size_t, [vp]),
         "curvetet_surface_num_triangles": (c.c_size_t, [vp]),
         "curvetet_surface_nodes": (dp, [vp]),
         "curvetet_surface_triangles": (c.c_int, [vp, up, ip]),
+        "curvetet_surface_num_regions": (c.c_size_t, [vp]),
         "curvetet_surface_num_warnings": (c.c_size_t, [vp]),
         "curvetet_surface_warning": (c.c_char_p, [vp, c.c_size_t]),
     }

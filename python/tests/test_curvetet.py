@@ -7,6 +7,7 @@ import importlib.util
 import math
 import os
 import signal
+import warnings
 
 import numpy as np
 import pytest
@@ -94,6 +95,8 @@ def test_sphere_from_numpy(sphere):
     assert m.quality["num_tets"] == len(m.tets)
     assert m.quality["num_invalid"] == 0
     assert m.scaled_jacobian.shape == (len(m.tets),)
+    # One closed surface: one region, the volume's tag 1 on every tet.
+    assert m.num_regions == 1 and np.array_equal(m.tet_regions, np.ones(len(m.tets)))
     assert abs(m.scaled_jacobian.min() - m.quality["min_scaled_jacobian"]) < 1e-9
     assert isinstance(m.report, dict) and m.report
     assert m.target_size > 0
@@ -258,6 +261,7 @@ def test_to_pyvista(sphere):
     grid = m.to_pyvista()
     assert grid.n_cells == len(m.tets)
     assert set(np.unique(grid.celltypes)) == {pyvista.CellType.QUADRATIC_TETRA}
+    assert np.array_equal(np.asarray(grid.cell_data["Region"]), m.tet_regions)
 
 
 def test_tqdm_progress(capsys):
@@ -289,3 +293,180 @@ def test_ctrl_c_cancels():
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     finally:
         signal.signal(signal.SIGINT, old)
+
+
+# --- Several regions -------------------------------------------------------------------
+
+def data_file(name: str) -> str:
+    """A file of the repository's tests/data ($CURVETET_TEST_DATA, which scripts/python-test
+    sets since it runs the tests outside the tree, else found beside python/tests)."""
+    root = os.environ.get("CURVETET_TEST_DATA") or os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "data")
+    path = os.path.join(root, name)
+    assert os.path.exists(path), "no %s: set CURVETET_TEST_DATA to tests/data" % path
+    return path
+
+
+def linear_volumes(nodes: np.ndarray, tets: np.ndarray) -> np.ndarray:
+    """Volumes of the straight tets of the corner nodes (which tile the polyhedron of the
+    boundary's corner triangles exactly, curved or not)."""
+    x = nodes[tets[:, :4]]
+    return np.einsum("ti,ti->t", np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]),
+                     x[:, 3] - x[:, 0]) / 6.0
+
+
+def polyhedron_volume(nodes: np.ndarray, tris: np.ndarray) -> float:
+    """Volume enclosed by closed, outward triangles (their corners), by the divergence
+    theorem."""
+    x = nodes[tris[:, :3]]
+    return float(np.einsum("ti,ti->t", x[:, 0], np.cross(x[:, 1], x[:, 2])).sum() / 6.0)
+
+
+def face_regions(m: curvetet.Mesh) -> dict[tuple[int, ...], list[int]]:
+    """Each tet face (its sorted corners) -> the region ids of the tets having it."""
+    faces: dict[tuple[int, ...], list[int]] = {}
+    for tet, region in zip(m.tets[:, :4].tolist(), m.tet_regions.tolist()):
+        for skip in range(4):
+            key = tuple(sorted(tet[:skip] + tet[skip + 1:]))
+            faces.setdefault(key, []).append(region)
+    return faces
+
+
+def p2_sphere(radius: float, level: int, first: int) -> tuple[np.ndarray, np.ndarray]:
+    """An icosphere of 6-node triangles (outward) with its mid nodes on the sphere; node
+    indices start at ``first``."""
+    points, tris = icosphere(level)
+    nodes = list(points)
+    mids: dict[tuple[int, int], int] = {}
+    tri6 = []
+    for a, b, c in tris.tolist():
+        row = [a, b, c]
+        for i, j in ((a, b), (b, c), (c, a)):
+            key = (min(i, j), max(i, j))
+            if key not in mids:
+                p = nodes[i] + nodes[j]
+                nodes.append(p / np.linalg.norm(p))
+                mids[key] = len(nodes) - 1
+            row.append(mids[key])
+        tri6.append(row)
+    return radius * np.array(nodes), np.array(tri6, dtype=np.int64) + first
+
+
+def nested_spheres() -> tuple[np.ndarray, np.ndarray, int]:
+    """A unit sphere inside a sphere of radius 2 (P2): nodes, triangles, and the number of
+    the inner sphere's triangles (first)."""
+    inner_pts, inner = p2_sphere(1.0, 1, 0)
+    outer_pts, outer = p2_sphere(2.0, 2, len(inner_pts))
+    return np.vstack([inner_pts, outer_pts]), np.vstack([inner, outer]), len(inner)
+
+
+def test_two_region_box_from_file():
+    """tests/data/split_box_p2.msh: the box [0,2]x[0,1]x[0,1] with a wall at x = 1."""
+    s = curvetet.read(data_file("split_box_p2.msh"))
+    assert s.num_regions == 2, s
+    m = curvetet.mesh(s, threads=2)
+    assert m.num_regions == 2
+    assert m.tet_regions.shape == (len(m.tets),) and m.tet_regions.dtype == np.int32
+    assert set(m.tet_regions.tolist()) == {1, 2}
+    assert m.quality["num_invalid"] == 0
+    # Each region is one half: its tets on one side of the wall, a unit volume.
+    x = m.nodes[m.tets[:, :4]].mean(axis=1)[:, 0]
+    left = m.tet_regions[np.argmin(x)]
+    right = 3 - left
+    assert (x[m.tet_regions == left] < 1.0).all() and (x[m.tet_regions == right] > 1.0).all()
+    vol = linear_volumes(m.nodes, m.tets)
+    assert (vol > 0).all()
+    for region in (left, right):
+        assert abs(vol[m.tet_regions == region].sum() - 1.0) < 1e-9, region
+    # The wall's triangles are among the boundary faces once, each shared by a tet of
+    # each region; every other boundary triangle is the face of one tet.
+    faces = face_regions(m)
+    on_wall = np.all(m.nodes[m.boundary_faces[:, :3], 0] == 1.0, axis=1)
+    assert on_wall.sum() > 0
+    tri_x = m.nodes[m.boundary_faces[:, :3], 0].mean(axis=1)
+    for tri, wall, cx in zip(m.boundary_faces[:, :3].tolist(), on_wall.tolist(), tri_x):
+        regions = sorted(faces[tuple(sorted(tri))])
+        assert regions == ([1, 2] if wall else [left if cx < 1.0 else right]), tri
+
+
+def test_nested_spheres_two_regions(tmp_path):
+    points, tris, n_inner = nested_spheres()
+    # Without the flag the inner sphere is a cavity: one region.
+    assert curvetet.surface(points, tris).num_regions == 1
+    assert curvetet.surface(points, tris, nested_regions=True).num_regions == 2
+    m = curvetet.mesh(points, tris, nested_regions=True, threads=2)
+    assert m.num_regions == 2
+    ids = set(m.tet_regions.tolist())
+    assert len(ids) == 2 and min(ids) > 0
+    assert m.quality["num_invalid"] == 0
+    # The region of the tet nearest the centre is the ball; the other the shell.
+    centre = np.linalg.norm(m.nodes[m.tets[:, :4]].mean(axis=1), axis=1)
+    ball = int(m.tet_regions[np.argmin(centre)])
+    (shell,) = ids - {ball}
+    vol = linear_volumes(m.nodes, m.tets)
+    assert (vol > 0).all()
+    v_in = polyhedron_volume(points, tris[:n_inner])
+    v_out = polyhedron_volume(points, tris[n_inner:])
+    for region, want in ((ball, v_in), (shell, v_out - v_in)):
+        got = vol[m.tet_regions == region].sum()
+        assert abs(got - want) / want < 1e-9, (region, got, want)
+    # The inner sphere is the interface: each of its triangles a face of a ball tet and a
+    # shell tet; the outer sphere's triangles are faces of one shell tet.
+    faces = face_regions(m)
+    for tri in tris[:n_inner, :3].tolist():
+        assert sorted(faces[tuple(sorted(tri))]) == sorted([ball, shell]), tri
+    for tri in tris[n_inner:, :3].tolist():
+        assert faces[tuple(sorted(tri))] == [shell], tri
+    assert len(m.boundary_faces) == len(tris)
+    # The written .msh puts each region in its own physical volume (read by meshio).
+    path = tmp_path / "nested.msh"
+    m.write(path)
+    meshio = optional("meshio")
+    back = meshio.read(path)
+    got = set()
+    for block, phys in zip(back.cells, back.cell_data["gmsh:physical"]):
+        if block.type == "tetra10":
+            got |= {(tuple(sorted(t)), int(r)) for t, r in zip(block.data[:, :4].tolist(), phys)}
+    want = {(tuple(sorted(t)), r) for t, r in zip(m.tets[:, :4].tolist(), m.tet_regions.tolist())}
+    assert got == want
+
+
+def test_nested_regions_arguments():
+    points, tris, _ = nested_spheres()
+    s = curvetet.surface(points, tris, nested_regions=True)
+    with pytest.raises(ValueError, match="nested_regions"):
+        curvetet.mesh(s, nested_regions=True)
+    lin_points, lin_tris = icosphere(1)
+    with pytest.raises(ValueError, match="nested_regions"):
+        curvetet.surface(lin_points, lin_tris, nested_regions=True)
+
+
+@pytest.fixture(scope="module")
+def split_box() -> curvetet.Mesh:
+    return curvetet.mesh(curvetet.read(data_file("split_box_p2.msh")), threads=2)
+
+
+@pytest.mark.parametrize("ext,fmt", [(".vtu", "vtu"), (".vtk", "vtk")])
+def test_regions_meshio_round_trip(split_box, tmp_path, capfd, ext, fmt):
+    meshio = optional("meshio")
+    m = split_box
+    mm = m.to_meshio()
+    tet_block = [c.type for c in mm.cells].index("tetra10")
+    assert np.array_equal(mm.cell_data["region"][tet_block], m.tet_regions)
+    path = tmp_path / ("regions" + ext)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        meshio.write(path, mm, file_format=fmt)
+    assert "warning" not in capfd.readouterr().err.lower()
+    back = meshio.read(path)
+    block = [c.type for c in back.cells].index("tetra10")
+    assert np.array_equal(back.cells[block].data, m.tets_vtk)
+    assert np.array_equal(np.asarray(back.cell_data["region"][block]), m.tet_regions)
+    assert sorted(np.unique(back.cell_data["region"][block]).tolist()) == [1, 2]
+
+
+def test_regions_to_pyvista(split_box):
+    optional("pyvista")
+    grid = split_box.to_pyvista()
+    assert np.array_equal(np.asarray(grid.cell_data["Region"]), split_box.tet_regions)
+    assert sorted(np.unique(grid.cell_data["Region"]).tolist()) == [1, 2]
