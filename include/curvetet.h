@@ -574,8 +574,9 @@ enum curvetet_status curvetet_surface_from_arrays(const double *xyz,
                                                   struct curvetet_surface **out);
 
 /**
- * `curvetet_surface_from_arrays` with `flags`: 0, or `CURVETET_SURFACE_STRICT`.
- * Statuses as `curvetet_surface_from_arrays`, and `CURVETET_ERR_INVALID_ARGUMENT` for
+ * `curvetet_surface_from_arrays` with `flags`: 0, or a bitwise or of
+ * `CURVETET_SURFACE_STRICT` and `CURVETET_SURFACE_NESTED_REGIONS` (a shell nested in
+ * another bounds a region of its own rather than a cavity). Statuses as `curvetet_surface_from_arrays`, and `CURVETET_ERR_INVALID_ARGUMENT` for
  * unknown flag bits.
  *
  * # Safety
@@ -682,9 +683,10 @@ enum curvetet_status curvetet_surface_from_linear_with_flags(const double *xyz,
 enum curvetet_status curvetet_surface_read(const char *path, struct curvetet_surface **out);
 
 /**
- * `curvetet_surface_read` with `flags`: 0, or `CURVETET_SURFACE_STRICT` (refuse
- * inconsistently oriented triangles and unused nodes rather than flip and drop them
- * with a warning). Statuses as `curvetet_surface_read`, and
+ * `curvetet_surface_read` with `flags`: 0, or a bitwise or of `CURVETET_SURFACE_STRICT`
+ * (refuse inconsistently oriented triangles and unused nodes rather than flip and drop
+ * them with a warning) and `CURVETET_SURFACE_NESTED_REGIONS` (a shell nested in another
+ * bounds a region of its own rather than a cavity). Statuses as `curvetet_surface_read`, and
  * `CURVETET_ERR_INVALID_ARGUMENT` for unknown flag bits.
  *
  * # Safety

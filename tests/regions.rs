@@ -141,6 +141,64 @@ fn a_sphere_inside_a_sphere_meshes_into_two_conforming_regions() {
     assert!(g.mesh.boundary_tags[half..].iter().all(|&t| t == 0));
     assert_eq!(g.mesh.groups.name(2, 2), Some("interface_1_2"));
     assert_msh_regions(&g, &[1, 2]);
+    // Each volume entity lists the surfaces bounding it: the ball only the interface.
+    assert_eq!(
+        msh_volume_bounds(&g),
+        vec![(1, vec![2]), (2, surface_entities_of(&g))]
+    );
+}
+
+/// The (volume entity, bounding surface entities) of the ASCII msh 4.1 output.
+fn msh_volume_bounds(g: &Generated) -> Vec<(i32, Vec<i32>)> {
+    let bytes =
+        io::mesh_to_bytes(&g.mesh, io::Format::Msh, &WriteOptions::default()).expect("writes");
+    let text = String::from_utf8(bytes).expect("ASCII");
+    let mut lines = text.lines().skip_while(|l| *l != "$Entities").skip(1);
+    let counts: Vec<usize> = lines
+        .next()
+        .expect("counts")
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let skip = counts[0] + counts[1] + counts[2];
+    lines
+        .skip(skip)
+        .take(counts[3])
+        .map(|l| {
+            let w: Vec<i64> = l
+                .split_whitespace()
+                .map(|x| x.parse::<f64>().unwrap() as i64)
+                .collect();
+            let nphys = w[7] as usize;
+            let nb = w[8 + nphys] as usize;
+            let b = w[9 + nphys..9 + nphys + nb]
+                .iter()
+                .map(|&x| x as i32)
+                .collect();
+            (w[0] as i32, b)
+        })
+        .collect()
+}
+
+/// The surface entity tags of the ASCII msh 4.1 output, ascending.
+fn surface_entities_of(g: &Generated) -> Vec<i32> {
+    let bytes =
+        io::mesh_to_bytes(&g.mesh, io::Format::Msh, &WriteOptions::default()).expect("writes");
+    let text = String::from_utf8(bytes).expect("ASCII");
+    let mut lines = text.lines().skip_while(|l| *l != "$Entities").skip(1);
+    let counts: Vec<usize> = lines
+        .next()
+        .expect("counts")
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let mut s: Vec<i32> = lines
+        .skip(counts[0] + counts[1])
+        .take(counts[2])
+        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    s.sort_unstable();
+    s
 }
 
 #[test]

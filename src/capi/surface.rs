@@ -211,8 +211,9 @@ fn repair_of(flags: u32) -> Result<Repair> {
     Ok(flags_of(flags)?.0)
 }
 
-/// `curvetet_surface_from_arrays` with `flags`: 0, or `CURVETET_SURFACE_STRICT`.
-/// Statuses as `curvetet_surface_from_arrays`, and `CURVETET_ERR_INVALID_ARGUMENT` for
+/// `curvetet_surface_from_arrays` with `flags`: 0, or a bitwise or of
+/// `CURVETET_SURFACE_STRICT` and `CURVETET_SURFACE_NESTED_REGIONS` (a shell nested in
+/// another bounds a region of its own rather than a cavity). Statuses as `curvetet_surface_from_arrays`, and `CURVETET_ERR_INVALID_ARGUMENT` for
 /// unknown flag bits.
 ///
 /// # Safety
@@ -435,9 +436,10 @@ pub unsafe extern "C" fn curvetet_surface_read(
     unsafe { read_call("curvetet_surface_read", path, 0, out) }
 }
 
-/// `curvetet_surface_read` with `flags`: 0, or `CURVETET_SURFACE_STRICT` (refuse
-/// inconsistently oriented triangles and unused nodes rather than flip and drop them
-/// with a warning). Statuses as `curvetet_surface_read`, and
+/// `curvetet_surface_read` with `flags`: 0, or a bitwise or of `CURVETET_SURFACE_STRICT`
+/// (refuse inconsistently oriented triangles and unused nodes rather than flip and drop
+/// them with a warning) and `CURVETET_SURFACE_NESTED_REGIONS` (a shell nested in another
+/// bounds a region of its own rather than a cavity). Statuses as `curvetet_surface_read`, and
 /// `CURVETET_ERR_INVALID_ARGUMENT` for unknown flag bits.
 ///
 /// # Safety

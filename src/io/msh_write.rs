@@ -21,6 +21,40 @@ const TET10: i32 = 11;
 /// The volume's entity tag.
 const VOLUME_ENTITY: i32 = 1;
 
+/// For each volume entity of `volumes`, the surface entities of the triangles that are
+/// faces of its tets (`tet_entity`), ascending.
+fn bounding_surfaces(
+    view: &MeshView,
+    tri_entity: &[i32],
+    volumes: &[(i32, i32)],
+    tet_entity: &[i32],
+) -> Vec<Vec<i32>> {
+    let key = |mut f: [u32; 3]| {
+        f.sort_unstable();
+        f
+    };
+    let mut face_entity: std::collections::HashMap<[u32; 3], i32> =
+        std::collections::HashMap::with_capacity(view.tri6.len());
+    for (t, &e) in view.tri6.iter().zip(tri_entity) {
+        face_entity.insert(key([t[0], t[1], t[2]]), e);
+    }
+    let mut per: BTreeMap<i32, std::collections::BTreeSet<i32>> = BTreeMap::new();
+    for (t, &v) in view.tet10.iter().zip(tet_entity) {
+        for f in [[0, 1, 2], [0, 1, 3], [0, 2, 3], [1, 2, 3]] {
+            if let Some(&e) = face_entity.get(&key(f.map(|k| t[k]))) {
+                per.entry(v).or_default().insert(e);
+            }
+        }
+    }
+    volumes
+        .iter()
+        .map(|(v, _)| {
+            per.get(v)
+                .map_or_else(Vec::new, |s| s.iter().copied().collect())
+        })
+        .collect()
+}
+
 /// Surface entities: one per boundary tag, each in its own physical group (see
 /// [`Resolved`]); the entity's tag is its physical tag.
 struct Entities {
@@ -32,6 +66,10 @@ struct Entities {
     volumes: Vec<(i32, i32)>,
     /// Each tet's volume entity tag.
     tet_entity: Vec<i32>,
+    /// With several regions, the surface entities bounding each volume entity (those
+    /// with a triangle that is a face of one of its tets), ascending; empty otherwise
+    /// (every surface entity bounds the one volume).
+    volume_surfaces: Vec<Vec<i32>>,
 }
 
 impl Entities {
@@ -52,12 +90,26 @@ impl Entities {
                 view.tet_regions.to_vec(),
             )
         };
+        let volume_surfaces = if view.tet_regions.is_empty() {
+            Vec::new()
+        } else {
+            bounding_surfaces(view, &tri_entity, &volumes, &tet_entity)
+        };
         Entities {
             groups,
             tri_entity,
             has_volume,
             volumes,
             tet_entity,
+            volume_surfaces,
+        }
+    }
+
+    /// The surface entities bounding volume entity number `i` (in `volumes`).
+    fn bounding(&self, i: usize) -> Vec<i32> {
+        match self.volume_surfaces.get(i) {
+            Some(s) => s.clone(),
+            None => self.surfaces(),
         }
     }
 
@@ -287,15 +339,16 @@ fn write41<W: Write>(o: &mut Out<W>, view: &MeshView) -> io::Result<()> {
         o.int(etag, b" ")?;
         o.size(0, b"\n")?;
     }
-    for &(etag, phys) in &ents.volumes[..nvol] {
+    for (i, &(etag, phys)) in ents.volumes[..nvol].iter().enumerate() {
         o.int(etag, b" ")?;
         for x in vol_box.get(&etag).copied().unwrap_or([0.0; 6]) {
             o.double(x, b" ")?;
         }
         o.size(1, b" ")?;
         o.int(phys, b" ")?;
-        o.size(surfaces.len() as u64, b"")?;
-        for &etag in &surfaces {
+        let bounding = ents.bounding(i);
+        o.size(bounding.len() as u64, b"")?;
+        for &etag in &bounding {
             if !o.binary {
                 o.raw(b" ")?;
             }
