@@ -2,10 +2,11 @@
 //! thread count (1, 2, 4) and from run to run, for every tests/data P2 surface (and every
 //! ../shared/data one, when present), through the library and through the CLI. A surface
 //! that does not mesh yet (the hinge) must fail identically: same message, and the same
-//! bytes for the mesh the error keeps (`--keep-partial`).
+//! bytes for the mesh the error keeps (`--keep-partial`). A surface of several regions
+//! (split_box) goes the way the CLI takes it ([`generate_input`]).
 
 use curvetet::io::{mesh_to_bytes, Format, MshVersion, WriteOptions};
-use curvetet::{generate, io, Error, Options};
+use curvetet::{generate_input, Error, MeshInput, Options, RegionMode};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -56,9 +57,9 @@ type Files = Vec<Vec<u8>>;
 
 /// The output files, or the error message and the files of the mesh it keeps.
 fn mesh_bytes(path: &Path, threads: usize) -> Result<Files, (String, Files)> {
-    let s = io::read_surface(path).unwrap();
+    let s = MeshInput::read(path, &Default::default(), RegionMode::Auto).unwrap();
     let opts = Options::default().with_threads(threads);
-    match generate(&s, &opts) {
+    match generate_input(&s, &opts, &mut |_, _| false) {
         Ok(g) => Ok(write_all(&g.mesh)),
         Err(e) => {
             let kept = match &e {
