@@ -14,10 +14,15 @@ Exits non-zero (an AssertionError) on the first failed check.
 import os
 import sys
 
-import numpy as np
-from paraview import servermanager as sm
-from paraview.simple import LoadPlugin, Sphere, STLReader, Triangulate
-from vtkmodules.util.numpy_support import vtk_to_numpy
+# ParaView's Python modules unpacked beside a system VTK's (scripts/fetch-paraview-python):
+# theirs first, or `vtkmodules` would be python3-vtk9's.
+if os.environ.get("CURVETET_PARAVIEW_PYTHONPATH"):
+    sys.path.insert(0, os.environ["CURVETET_PARAVIEW_PYTHONPATH"])
+
+import numpy as np  # noqa: E402
+from paraview import servermanager as sm  # noqa: E402
+from paraview.simple import LoadPlugin, Sphere, STLReader, Triangulate  # noqa: E402
+from vtkmodules.util.numpy_support import vtk_to_numpy  # noqa: E402
 
 VTK_TRIANGLE = 5
 VTK_QUADRATIC_TRIANGLE = 22
