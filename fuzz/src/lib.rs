@@ -1,14 +1,15 @@
 //! Shared checks of the curvetet fuzz targets (see README.md).
 
-use curvetet::io::{read_bytes, surface_from_raw_any, Format, RawMesh};
+use curvetet::io::{read_bytes, Format, RawMesh};
 use curvetet::mesh::check::check_conformity;
 use curvetet::mesh::report::uncertified;
 use curvetet::surface::curve::CurveOptions;
 use curvetet::surface::demo::icosphere;
-use curvetet::{generate, Error, Options, SizeMode, Surface};
+use curvetet::{generate, Error, MeshInput, Options, RegionMode, SizeMode, Surface};
 
 /// Fuzz one reader: never panic; whatever it accepts has indices in range and one tag per
-/// element, and becomes a surface or a clean error.
+/// element, and becomes a surface, surfaces of several regions or a clean error (the
+/// path `curvetet mesh` takes: [`MeshInput::from_raw`], which splits regions).
 pub fn read(data: &[u8], format: Format) {
     let raw = match read_bytes(data, format, "fuzz") {
         Ok(raw) => raw,
@@ -18,8 +19,9 @@ pub fn read(data: &[u8], format: Format) {
         }
     };
     check_raw(&raw);
-    // The surface checks (and, for a linear file, the curving) on what was read.
-    if let Err(e) = surface_from_raw_any(raw, "fuzz", &CurveOptions::default()) {
+    // The region split, the surface checks (and, for a linear file, the curving) on what
+    // was read.
+    if let Err(e) = MeshInput::from_raw(raw, "fuzz", &CurveOptions::default(), RegionMode::Auto) {
         check_error(&e);
     }
 }
