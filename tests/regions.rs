@@ -148,8 +148,8 @@ fn a_sphere_inside_a_sphere_meshes_into_two_conforming_regions() {
     );
 }
 
-/// The (volume entity, bounding surface entities) of the ASCII msh 4.1 output.
-fn msh_volume_bounds(g: &Generated) -> Vec<(i32, Vec<i32>)> {
+/// The entity lines of the ASCII msh 4.1 output, by dimension (0 to 3).
+fn msh_entity_lines(g: &Generated) -> [Vec<String>; 4] {
     let bytes =
         io::mesh_to_bytes(&g.mesh, io::Format::Msh, &WriteOptions::default()).expect("writes");
     let text = String::from_utf8(bytes).expect("ASCII");
@@ -160,10 +160,17 @@ fn msh_volume_bounds(g: &Generated) -> Vec<(i32, Vec<i32>)> {
         .split_whitespace()
         .map(|x| x.parse().unwrap())
         .collect();
-    let skip = counts[0] + counts[1] + counts[2];
-    lines
-        .skip(skip)
-        .take(counts[3])
+    let mut out: [Vec<String>; 4] = Default::default();
+    for (dim, &n) in counts.iter().enumerate().take(4) {
+        out[dim] = lines.by_ref().take(n).map(str::to_string).collect();
+    }
+    out
+}
+
+/// The (volume entity, bounding surface entities) of the ASCII msh 4.1 output.
+fn msh_volume_bounds(g: &Generated) -> Vec<(i32, Vec<i32>)> {
+    msh_entity_lines(g)[3]
+        .iter()
         .map(|l| {
             let w: Vec<i64> = l
                 .split_whitespace()
@@ -182,19 +189,8 @@ fn msh_volume_bounds(g: &Generated) -> Vec<(i32, Vec<i32>)> {
 
 /// The surface entity tags of the ASCII msh 4.1 output, ascending.
 fn surface_entities_of(g: &Generated) -> Vec<i32> {
-    let bytes =
-        io::mesh_to_bytes(&g.mesh, io::Format::Msh, &WriteOptions::default()).expect("writes");
-    let text = String::from_utf8(bytes).expect("ASCII");
-    let mut lines = text.lines().skip_while(|l| *l != "$Entities").skip(1);
-    let counts: Vec<usize> = lines
-        .next()
-        .expect("counts")
-        .split_whitespace()
-        .map(|x| x.parse().unwrap())
-        .collect();
-    let mut s: Vec<i32> = lines
-        .skip(counts[0] + counts[1])
-        .take(counts[2])
+    let mut s: Vec<i32> = msh_entity_lines(g)[2]
+        .iter()
         .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
         .collect();
     s.sort_unstable();
