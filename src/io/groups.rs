@@ -176,6 +176,14 @@ fn clean(name: &str) -> String {
 mod tests {
     use super::*;
 
+    /// The resolved groups' names as (dim, tag, name).
+    fn names_of(r: &Resolved) -> Vec<(u8, i32, &str)> {
+        r.names
+            .iter()
+            .map(|n| (n.dim, n.tag, n.name.as_str()))
+            .collect()
+    }
+
     #[test]
     fn regions_are_volume_groups_named_by_the_input_or_by_id() {
         let g = Groups {
@@ -189,11 +197,7 @@ mod tests {
         let r = Resolved::new(&[0, 0], &g, true, &[7, 2, 7]);
         assert_eq!(r.volumes, vec![2, 7]);
         assert_eq!(r.volume, 2);
-        let names: Vec<_> = r
-            .names
-            .iter()
-            .map(|n| (n.dim, n.tag, n.name.as_str()))
-            .collect();
+        let names = names_of(&r);
         assert_eq!(
             names,
             vec![(2, 1, "boundary"), (3, 2, "region_2"), (3, 7, "blood")]
@@ -205,11 +209,7 @@ mod tests {
         let r = Resolved::new(&[0, 0, 0], &Groups::default(), true, &[]);
         assert_eq!(r.surface[&0], 1);
         assert_eq!(r.volume, VOLUME_TAG);
-        let names: Vec<_> = r
-            .names
-            .iter()
-            .map(|n| (n.dim, n.tag, n.name.as_str()))
-            .collect();
+        let names = names_of(&r);
         assert_eq!(names, vec![(2, 1, "boundary"), (3, 1, "volume")]);
     }
 
@@ -233,11 +233,7 @@ mod tests {
         let r = Resolved::new(&[1, 3, 0, -2, 3], &g, true, &[]);
         assert_eq!(r.triangle_tags(&[1, 3, 0, -2]), vec![1, 3, 2, 4]);
         assert_eq!(r.volume, 4);
-        let names: Vec<_> = r
-            .names
-            .iter()
-            .map(|n| (n.dim, n.tag, n.name.as_str()))
-            .collect();
+        let names = names_of(&r);
         assert_eq!(
             names,
             vec![(2, 1, "inlet"), (2, 2, "boundary"), (3, 4, "fluid 'x'")]
