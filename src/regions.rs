@@ -730,6 +730,7 @@ fn add_front(a: &mut FrontStats, b: &FrontStats) {
     a.repairs += b.repairs;
     a.deleted += b.deleted;
     a.cavities += b.cavities;
+    a.constrained += b.constrained;
     a.p2_invalid += b.p2_invalid;
     a.restarts += b.restarts;
     a.alpha = b.alpha;

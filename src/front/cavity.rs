@@ -255,29 +255,7 @@ impl Mesher<'_> {
                 boundary: self.faces[f as usize].btri != u32::MAX,
             })
             .collect();
-        // Other live front faces in the cavity's box: never to be crossed.
-        let mut bb = super::grid::Aabb::of(
-            &verts
-                .iter()
-                .map(|&v| self.pts[v as usize])
-                .collect::<Vec<_>>(),
-        );
-        for d in 0..3 {
-            let pad = 1e-9 * (bb.hi[d] - bb.lo[d]).abs().max(1.0);
-            bb.lo[d] -= pad;
-            bb.hi[d] += pad;
-        }
-        let faces = &self.faces;
-        let mut ids = Vec::new();
-        self.grid.query(&bb, |k| faces[k as usize].alive, &mut ids);
-        let fixed: Vec<FaceRef> = ids
-            .iter()
-            .filter(|k| !comp.contains(k))
-            .map(|&k| FaceRef {
-                v: self.faces[k as usize].v,
-                boundary: self.faces[k as usize].btri != u32::MAX,
-            })
-            .collect();
+        let fixed = self.fixed_around(comp);
         // First on the cavity's own vertices, then with the kernel's centre as a Steiner
         // point, then with up to three Steiner points placed where a face sees no vertex.
         let kernel = self.kernel_point(&open);
@@ -331,6 +309,32 @@ impl Mesher<'_> {
             }
         }
         false
+    }
+
+    /// The live front faces other than `comp`'s in the box of `comp`'s vertices: never to
+    /// be crossed by what fills it.
+    pub(super) fn fixed_around(&mut self, comp: &[u32]) -> Vec<FaceRef> {
+        let pts: Vec<P3> = comp
+            .iter()
+            .flat_map(|&f| self.faces[f as usize].v)
+            .map(|v| self.pts[v as usize])
+            .collect();
+        let mut bb = super::grid::Aabb::of(&pts);
+        for d in 0..3 {
+            let pad = 1e-9 * (bb.hi[d] - bb.lo[d]).abs().max(1.0);
+            bb.lo[d] -= pad;
+            bb.hi[d] += pad;
+        }
+        let faces = &self.faces;
+        let mut ids = Vec::new();
+        self.grid.query(&bb, |k| faces[k as usize].alive, &mut ids);
+        ids.iter()
+            .filter(|k| !comp.contains(k))
+            .map(|&k| FaceRef {
+                v: self.faces[k as usize].v,
+                boundary: self.faces[k as usize].btri != u32::MAX,
+            })
+            .collect()
     }
 
     /// A point strictly inside every face's inner half-space (the Chebyshev centre of the

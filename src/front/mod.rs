@@ -10,6 +10,7 @@
 //! faces close them.
 
 mod cavity;
+mod constrained;
 mod diagnose;
 mod grid;
 mod queue;
@@ -59,6 +60,8 @@ pub struct FrontStats {
     pub deleted: u64,
     /// Stuck cavities closed by the exact search.
     pub cavities: u64,
+    /// Stuck cavities closed by the constrained fill.
+    pub constrained: u64,
     /// Tets accepted as a last resort with a non-positive P2 Jacobian (linear-valid, with
     /// a free mid node), left for the high-order optimizer to untangle.
     pub p2_invalid: u64,
@@ -595,6 +598,11 @@ impl<'a> Mesher<'a> {
             if let Some(comp) = self.component(fid, cavity::MAX_CAVITY_FACES) {
                 if self.fill_cavity(&comp) {
                     self.stats.cavities += 1;
+                    continue;
+                }
+                let fixed = self.fixed_around(&comp);
+                if self.constrained_fill(&comp, &fixed) {
+                    self.stats.constrained += 1;
                     continue;
                 }
             }

@@ -2,6 +2,8 @@
 //! Bernstein (Bézier) bounds of the P2 tetrahedron's Jacobian, and quality metrics.
 
 pub mod bezier;
+pub(crate) mod cdt_fill;
+pub(crate) mod delaunay;
 pub mod distance;
 pub mod predicates;
 pub mod quadrature;

@@ -1,0 +1,838 @@
+//! The constrained fill: a tetrahedralization of the region a closed triangle surface
+//! encloses, with every surface triangle kept exactly as a face and every added point
+//! strictly inside. The advancing front hands it what it cannot close.
+//!
+//! 1. Delaunay tetrahedralization of the surface's vertices ([`Delaunay`]).
+//! 2. Edge recovery: flips first; where they cannot, a Steiner point where the segment
+//!    leaves the tet at its current end (a face split, or an edge split when it crosses an
+//!    edge), walking to the other end. Recovered pieces are fixed: no flip removes them.
+//! 3. Face recovery: every mesh edge that crosses a triangle's interior is split at the
+//!    crossing (each split removes one crossing edge and adds none), until the triangle is
+//!    a union of mesh faces.
+//! 4. The enclosed tets by parity across the constraint faces; the rest are dropped.
+//! 5. Every Steiner point is then moved off the surface (TetGen's `-Y`): its star's
+//!    constraint faces are retriangulated without it (ear clipping in the triangle's
+//!    plane, exact 2D orientations) and it is placed along the inward normal where every
+//!    tet of its new star is positive. The surface triangles come back exactly.
+//!
+//! Every topological decision is an exact orient3d/orient2d; the Steiner coordinates are
+//! rounded, which the final checks cover: the boundary faces must be the input triangles
+//! and every tet positive, or the fill reports what went wrong.
+
+use super::delaunay::{sorted2, sorted3, Delaunay, FACES, NONE};
+use super::predicates::{orient3d, projection_of};
+use super::vec3::{axpy, dist, dot, norm, sub, tet_det, tri_normal, P3};
+use std::collections::{HashMap, HashSet};
+
+/// A filled region: the input points then the new interior points, and positive tets.
+pub(crate) struct Filled {
+    pub pts: Vec<P3>,
+    pub tets: Vec<[u32; 4]>,
+}
+
+/// Tetrahedralize the region bounded by `faces` (indices into `pts`, each oriented with the
+/// region on its positive side: `orient3d(a, b, c, x) > 0` for `x` inside). The result's
+/// boundary faces are exactly `faces`; new points are strictly inside. Err names the
+/// stage that could not go on (a degenerate or self-intersecting surface, or a rounded
+/// Steiner point that would invert a tet).
+pub(crate) fn fill(pts: &[P3], faces: &[[u32; 3]]) -> Result<Filled, &'static str> {
+    let mut c = Cdt::new(pts, faces)?;
+    c.recover_edges()?;
+    for i in 0..faces.len() {
+        c.recover_face(i)?;
+    }
+    c.keep_enclosed()?;
+    c.remove_steiner_points()?;
+    c.result()
+}
+
+/// Flips tried per segment or face to clear nearly flat tets out of a split's way.
+const MAX_UNBLOCK: usize = 64;
+
+struct Cdt<'a> {
+    dt: Delaunay,
+    faces: &'a [[u32; 3]],
+    /// Per sorted input edge: its chain of mesh vertices from `key[0]` to `key[1]`.
+    chains: HashMap<[u32; 2], Vec<u32>>,
+    /// Per input face: the Steiner points inside it.
+    inner: Vec<Vec<u32>>,
+    /// Sorted constraint sub-face -> its input face.
+    parent: HashMap<[u32; 3], usize>,
+}
+
+impl<'a> Cdt<'a> {
+    fn new(pts: &[P3], faces: &'a [[u32; 3]]) -> Result<Cdt<'a>, &'static str> {
+        let dt = Delaunay::new(pts);
+        let n = pts.len();
+        if faces.iter().flatten().any(|&v| v as usize >= n) {
+            return Err("a face refers to a missing point");
+        }
+        let used: HashSet<u32> = faces.iter().flatten().copied().collect();
+        if used.iter().any(|&v| dt.star(v).is_empty()) {
+            return Err("two surface points coincide");
+        }
+        Ok(Cdt {
+            dt,
+            faces,
+            chains: HashMap::new(),
+            inner: vec![Vec::new(); faces.len()],
+            parent: HashMap::new(),
+        })
+    }
+
+    fn recover_edges(&mut self) -> Result<(), &'static str> {
+        let mut edges: Vec<[u32; 2]> = self
+            .faces
+            .iter()
+            .flat_map(|f| (0..3).map(move |k| sorted2(f[k], f[(k + 1) % 3])))
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        // Those already there first: fixed, later flips keep them.
+        for e in &edges {
+            if self.dt.has_edge(e[0], e[1]) {
+                self.dt.fixed_edges.insert(*e);
+                self.chains.insert(*e, e.to_vec());
+            }
+        }
+        for e in &edges {
+            if !self.chains.contains_key(e) {
+                let chain = self.recover_segment(e[0], e[1])?;
+                self.chains.insert(*e, chain);
+            }
+        }
+        Ok(())
+    }
+
+    /// Make segment ab a chain of mesh edges: flips, else a Steiner point where the
+    /// segment leaves the tet at its current end.
+    fn recover_segment(&mut self, a: u32, b: u32) -> Result<Vec<u32>, &'static str> {
+        let mut chain = vec![a];
+        let mut cur = a;
+        let mut flips = 0;
+        for _ in 0..1_000_000 {
+            if self.dt.recover_edge(cur, b, 32) || self.dt.recover_edge_any(cur, b, 32) {
+                chain.push(b);
+                self.dt.fixed_edges.insert(sorted2(cur, b));
+                return Ok(chain);
+            }
+            let (t, k) = self
+                .dt
+                .leaving(cur, b)
+                .ok_or("no tet leaves a segment's end toward its other end")?;
+            let tv = self.dt.tets[t as usize];
+            let f = FACES[k].map(|j| tv[j]);
+            let fp = f.map(|v| self.dt.p(v));
+            let (pc, pb) = (self.dt.p(cur), self.dt.p(b));
+            let o = [0, 1, 2].map(|e| orient3d(pc, pb, fp[e], fp[(e + 1) % 3]));
+            let split = match o.iter().filter(|&&x| x == 0).count() {
+                0 => {
+                    let p = segment_plane(pc, pb, fp);
+                    // Rounded next to an edge of the face, a face split inverts a tet:
+                    // split the nearest edges instead.
+                    self.dt.split_face(t, k, p).or_else(|mut bad| {
+                        let mut es = [0, 1, 2];
+                        es.sort_by(|&i, &j| {
+                            let d = |e: usize| line_dist(p, fp[e], fp[(e + 1) % 3]);
+                            d(i).total_cmp(&d(j))
+                        });
+                        for e in es {
+                            let (x, y) = (f[e], f[(e + 1) % 3]);
+                            let q = segment_line(pc, pb, fp[e], fp[(e + 1) % 3]);
+                            match self.dt.split_edge(x, y, q) {
+                                Ok(s) => return Ok(s),
+                                Err(b) => bad.extend(b),
+                            }
+                        }
+                        Err(bad)
+                    })
+                }
+                1 => {
+                    let e = o.iter().position(|&x| x == 0).unwrap_or(0);
+                    let (x, y) = (f[e], f[(e + 1) % 3]);
+                    let p = segment_line(pc, pb, self.dt.p(x), self.dt.p(y));
+                    self.dt.split_edge(x, y, p)
+                }
+                _ => return Err("a surface edge passes through a vertex"),
+            };
+            let s = match split {
+                Ok(s) => s,
+                Err(bad) => {
+                    // Nearly flat tets in the way: flip them and walk again.
+                    flips += 1;
+                    if flips <= MAX_UNBLOCK && self.dt.flip_away(&bad) {
+                        continue;
+                    }
+                    return Err("a Steiner point on a surface edge would invert a tet");
+                }
+            };
+            self.dt.fixed_edges.insert(sorted2(cur, s));
+            chain.push(s);
+            cur = s;
+        }
+        Err("edge recovery did not end")
+    }
+
+    /// The chain of input edge (a, b), from a to b.
+    fn chain(&self, a: u32, b: u32) -> Vec<u32> {
+        let mut c = self.chains.get(&sorted2(a, b)).cloned().unwrap_or_default();
+        if a > b {
+            c.reverse();
+        }
+        c
+    }
+
+    /// Split every mesh edge crossing face `i`'s interior, then fix its sub-faces.
+    fn recover_face(&mut self, i: usize) -> Result<(), &'static str> {
+        let f = self.faces[i];
+        let fp = f.map(|v| self.dt.p(v));
+        let mut on: HashSet<u32> = HashSet::new();
+        let mut rim: HashSet<[u32; 2]> = HashSet::new();
+        for k in 0..3 {
+            let ch = self.chain(f[k], f[(k + 1) % 3]);
+            for w in ch.windows(2) {
+                rim.insert(sorted2(w[0], w[1]));
+            }
+            on.extend(ch);
+        }
+        on.extend(self.inner[i].iter().copied());
+        let side = |dt: &Delaunay, on: &HashSet<u32>, v: u32| {
+            if on.contains(&v) {
+                0
+            } else {
+                orient3d(fp[0], fp[1], fp[2], dt.p(v))
+            }
+        };
+        let mut flips = 0;
+        loop {
+            let mut near: Vec<u32> = on.iter().flat_map(|&v| self.dt.star(v)).collect();
+            near.sort_unstable();
+            near.dedup();
+            let mut crossing = None;
+            'find: for &t in &near {
+                let tv = self.dt.tets[t as usize];
+                for a in 0..4 {
+                    for b in a + 1..4 {
+                        let (u, v) = (tv[a], tv[b]);
+                        let (su, sv) = (side(&self.dt, &on, u), side(&self.dt, &on, v));
+                        if su * sv >= 0 {
+                            continue;
+                        }
+                        let (pu, pv) = (self.dt.p(u), self.dt.p(v));
+                        let o = [0, 1, 2].map(|e| orient3d(pu, pv, fp[e], fp[(e + 1) % 3]));
+                        if o.iter().all(|&x| x > 0) || o.iter().all(|&x| x < 0) {
+                            crossing = Some((u, v));
+                            break 'find;
+                        }
+                    }
+                }
+            }
+            let Some((u, v)) = crossing else {
+                break;
+            };
+            let (pu, pv) = (self.dt.p(u), self.dt.p(v));
+            let p = segment_plane(pu, pv, fp);
+            let s = match self.dt.split_edge(u, v, p) {
+                Ok(s) => s,
+                Err(bad) => {
+                    flips += 1;
+                    if flips <= MAX_UNBLOCK && self.dt.flip_away(&bad) {
+                        continue;
+                    }
+                    return Err("a Steiner point in a surface triangle would invert a tet");
+                }
+            };
+            on.insert(s);
+            self.inner[i].push(s);
+        }
+        // The sub-faces: mesh faces on `on` points only; a disk with the rim as boundary.
+        let mut near: Vec<u32> = on.iter().flat_map(|&v| self.dt.star(v)).collect();
+        near.sort_unstable();
+        near.dedup();
+        let mut subs: HashSet<[u32; 3]> = HashSet::new();
+        for &t in &near {
+            let tv = self.dt.tets[t as usize];
+            if tv.iter().all(|v| on.contains(v)) {
+                return Err("a flat tet lies in a surface triangle");
+            }
+            for fk in FACES {
+                let g = fk.map(|j| tv[j]);
+                if g.iter().all(|v| on.contains(v)) {
+                    subs.insert(sorted3(g));
+                }
+            }
+        }
+        let mut uses: HashMap<[u32; 2], u32> = HashMap::new();
+        for g in &subs {
+            for k in 0..3 {
+                *uses.entry(sorted2(g[k], g[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        let disk = uses
+            .iter()
+            .all(|(e, &n)| n == if rim.contains(e) { 1 } else { 2 })
+            && rim.iter().all(|e| uses.contains_key(e));
+        if !disk {
+            return Err("a surface triangle is not recovered as a disk of faces");
+        }
+        for g in subs {
+            for k in 0..3 {
+                self.dt.fixed_edges.insert(sorted2(g[k], g[(k + 1) % 3]));
+            }
+            self.dt.fixed_faces.insert(g);
+            if self.parent.insert(g, i).is_some_and(|j| j != i) {
+                return Err("two surface triangles share a recovered face");
+            }
+        }
+        Ok(())
+    }
+
+    /// Keep the tets the constraint faces enclose (odd parity from the enclosing points),
+    /// checking that each constraint face has the region on its positive side.
+    fn keep_enclosed(&mut self) -> Result<(), &'static str> {
+        let nt = self.dt.tets.len();
+        let far = self.dt.n as u32..self.dt.n as u32 + 4;
+        let start = (0..nt)
+            .find(|&t| self.dt.alive[t] && self.dt.tets[t].iter().any(|v| far.contains(v)))
+            .ok_or("no outer tet")?;
+        let mut state = vec![0u8; nt]; // 0 unknown, 1 outside, 2 inside
+        state[start] = 1;
+        let mut stack = vec![start as u32];
+        while let Some(t) = stack.pop() {
+            let tv = self.dt.tets[t as usize];
+            for (k, fk) in FACES.iter().enumerate() {
+                let nb = self.dt.adj[t as usize][k];
+                if nb == NONE {
+                    continue;
+                }
+                let wall = self.dt.fixed_faces.contains(&sorted3(fk.map(|j| tv[j])));
+                let s = state[t as usize];
+                let want = if wall { 3 - s } else { s };
+                match state[nb as usize] {
+                    0 => {
+                        state[nb as usize] = want;
+                        stack.push(nb);
+                    }
+                    x if x != want => return Err("the surface does not enclose consistently"),
+                    _ => {}
+                }
+            }
+        }
+        for t in 0..nt {
+            if !self.dt.alive[t] || state[t] != 2 {
+                continue;
+            }
+            let tv = self.dt.tets[t];
+            if tv.iter().any(|v| far.contains(v)) {
+                return Err("the surface does not enclose the region");
+            }
+            for (k, fk) in FACES.iter().enumerate() {
+                let g = fk.map(|j| tv[j]);
+                if self.parent.contains_key(&sorted3(g)) {
+                    // The region must be on the face's positive side: its outward face
+                    // (g) turns against the input face in the input face's plane.
+                    let i = self.parent[&sorted3(g)];
+                    let f = self.faces[i].map(|v| self.dt.p(v));
+                    let (proj, sign) =
+                        projection_of(f[0], f[1], f[2]).ok_or("degenerate triangle")?;
+                    let gp = g.map(|v| self.dt.p(v));
+                    if proj.orient2d(gp[0], gp[1], gp[2]) != -sign {
+                        return Err("a surface triangle faces away from the region");
+                    }
+                }
+            }
+        }
+        for t in 0..nt {
+            if self.dt.alive[t] && state[t] != 2 {
+                self.dt.alive[t] = false;
+            }
+        }
+        for t in 0..nt {
+            if self.dt.alive[t] {
+                for k in 0..4 {
+                    let nb = self.dt.adj[t][k];
+                    if nb != NONE && !self.dt.alive[nb as usize] {
+                        self.dt.adj[t][k] = NONE;
+                    }
+                }
+            }
+        }
+        self.dt.rebuild_vt();
+        Ok(())
+    }
+
+    fn remove_steiner_points(&mut self) -> Result<(), &'static str> {
+        let first = self.dt.n as u32 + 4;
+        let last = self.dt.pts.len() as u32;
+        // How many input faces use each input edge (2, or 4 where two pockets touch).
+        let mut edge_faces: HashMap<[u32; 2], usize> = HashMap::new();
+        for f in self.faces {
+            for k in 0..3 {
+                *edge_faces.entry(sorted2(f[k], f[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        let mut on_edge: HashMap<u32, usize> = HashMap::new();
+        for (e, ch) in &self.chains {
+            for &v in &ch[1..ch.len() - 1] {
+                on_edge.insert(v, edge_faces.get(e).copied().unwrap_or(2));
+            }
+        }
+        for s in first..last {
+            let mut left = on_edge.get(&s).copied().unwrap_or(1);
+            let mut seen: HashSet<u32> = HashSet::new();
+            while left > 0 {
+                let star = self.dt.star(s);
+                let star = if star.iter().any(|t| seen.contains(t)) || star.is_empty() {
+                    // Another pocket at this point: its tets are not linked to the first.
+                    (0..self.dt.tets.len() as u32)
+                        .filter(|&t| {
+                            self.dt.alive[t as usize]
+                                && self.dt.tets[t as usize].contains(&s)
+                                && !seen.contains(&t)
+                        })
+                        .collect::<Vec<_>>()
+                } else {
+                    star
+                };
+                if star.is_empty() {
+                    break;
+                }
+                let comp = self.component(s, &star);
+                seen.extend(comp.iter().copied());
+                let groups = self.move_off(s, &comp)?;
+                left = left.saturating_sub(groups);
+            }
+        }
+        Ok(())
+    }
+
+    /// The tets of `star` (all containing `s`) linked to its first through faces at `s`.
+    fn component(&self, s: u32, star: &[u32]) -> Vec<u32> {
+        let set: HashSet<u32> = star.iter().copied().collect();
+        let mut out = vec![star[0]];
+        let mut k = 0;
+        while k < out.len() {
+            let t = out[k];
+            k += 1;
+            let tv = self.dt.tets[t as usize];
+            for j in 0..4 {
+                let nb = self.dt.adj[t as usize][j];
+                if tv[j] != s && nb != NONE && set.contains(&nb) && !out.contains(&nb) {
+                    out.push(nb);
+                }
+            }
+        }
+        out
+    }
+
+    /// Move Steiner point `s` off the surface within the tets `comp` around it. Returns
+    /// how many surface triangles it was on there.
+    fn move_off(&mut self, s: u32, comp: &[u32]) -> Result<usize, &'static str> {
+        // The constraint faces at s, outward, grouped by input face: edges x -> y of
+        // the faces (s, x, y).
+        let mut groups: HashMap<usize, Vec<[u32; 2]>> = HashMap::new();
+        let mut link: Vec<[u32; 4]> = Vec::new();
+        for &t in comp {
+            let tv = self.dt.tets[t as usize];
+            let ks = tv.iter().position(|&v| v == s).ok_or("star")?;
+            link.push(tv);
+            for (k, fk) in FACES.iter().enumerate() {
+                if k == ks || self.dt.adj[t as usize][k] != NONE {
+                    continue;
+                }
+                let g = fk.map(|j| tv[j]);
+                let i = *self
+                    .parent
+                    .get(&sorted3(g))
+                    .ok_or("a boundary face that is no surface triangle")?;
+                let r = (0..3).find(|&m| g[m] == s).unwrap_or(0);
+                groups
+                    .entry(i)
+                    .or_default()
+                    .push([g[(r + 1) % 3], g[(r + 2) % 3]]);
+            }
+        }
+        if groups.is_empty() {
+            return Err("a Steiner point inside the region"); // (never placed there)
+        }
+        let mut new_faces: Vec<([u32; 3], usize)> = Vec::new();
+        let mut inward = [0.0; 3];
+        for (&i, edges) in &groups {
+            let f = self.faces[i].map(|v| self.dt.p(v));
+            // The input face's positive side is the region's.
+            let nrm = tri_normal(f[0], f[1], f[2]);
+            let l = norm(nrm).max(f64::MIN_POSITIVE);
+            inward = axpy(inward, 1.0 / l, nrm);
+            let poly = polygon(edges).ok_or("the faces at a Steiner point are no fan")?;
+            let (proj, sign) = projection_of(f[0], f[1], f[2]).ok_or("degenerate triangle")?;
+            // Outward faces turn the other way from the input face.
+            let tris = ear_clip(&poly, |a, b, c| {
+                proj.orient2d(self.dt.p(a), self.dt.p(b), self.dt.p(c)) == -sign
+            })
+            .ok_or("the faces at a Steiner point cannot be retriangulated")?;
+            new_faces.extend(tris.into_iter().map(|t| (t, i)));
+        }
+        let ps = self.dt.p(s);
+        let reach = link
+            .iter()
+            .flatten()
+            .filter(|&&v| v != s)
+            .map(|&v| dist(ps, self.dt.p(v)))
+            .fold(f64::INFINITY, f64::min);
+        let centre = {
+            let vs: Vec<P3> = link
+                .iter()
+                .flatten()
+                .filter(|&&v| v != s)
+                .map(|&v| self.dt.p(v))
+                .collect();
+            let k = vs.len().max(1) as f64;
+            let c = vs.iter().fold([0.0; 3], |a, &p| axpy(a, 1.0 / k, p));
+            sub(c, ps)
+        };
+        let q = self.dt.add_point(ps);
+        let mut tets: Vec<[u32; 4]> = link
+            .iter()
+            .map(|tv| tv.map(|v| if v == s { q } else { v }))
+            .collect();
+        tets.extend(new_faces.iter().map(|(g, _)| [g[0], g[2], g[1], q]));
+        let mut placed = false;
+        'dirs: for d in [inward, centre] {
+            let l = norm(d);
+            if !(l > 0.0) || !reach.is_finite() {
+                continue;
+            }
+            for k in 1..60 {
+                let p = axpy(ps, reach * 0.5f64.powi(k) / l, d);
+                self.dt.pts[q as usize] = p;
+                if tets.iter().all(|&t| self.dt.positive(t)) {
+                    placed = true;
+                    break 'dirs;
+                }
+            }
+        }
+        if !placed {
+            return Err("no interior point sees a Steiner point's star");
+        }
+        self.dt.replace(comp, &tets);
+        for (g, i) in new_faces {
+            self.parent.insert(sorted3(g), i);
+        }
+        Ok(groups.len())
+    }
+
+    fn result(&self) -> Result<Filled, &'static str> {
+        let n = self.dt.n;
+        let first = n as u32 + 4;
+        let mut map: HashMap<u32, u32> = HashMap::new();
+        let mut pts: Vec<P3> = self.dt.pts[..n].to_vec();
+        let mut tets = Vec::new();
+        let mut bound: HashSet<[u32; 3]> = HashSet::new();
+        for t in 0..self.dt.tets.len() {
+            if !self.dt.alive[t] {
+                continue;
+            }
+            let tv = self.dt.tets[t];
+            if !self.dt.positive(tv) {
+                return Err("a tet is not positive");
+            }
+            for (k, fk) in FACES.iter().enumerate() {
+                if self.dt.adj[t][k] == NONE {
+                    let g = fk.map(|j| tv[j]);
+                    // Outward: the input face reversed, as a rotation-free key.
+                    bound.insert(canon([g[0], g[2], g[1]]));
+                }
+            }
+            let mut out = [0; 4];
+            for (o, &v) in out.iter_mut().zip(&tv) {
+                *o = if (v as usize) < n {
+                    v
+                } else if v >= first {
+                    if self.chains_or_inner_has(v) {
+                        return Err("a Steiner point stayed on the surface");
+                    }
+                    *map.entry(v).or_insert_with(|| {
+                        pts.push(self.dt.pts[v as usize]);
+                        (pts.len() - 1) as u32
+                    })
+                } else {
+                    return Err("an enclosing point in the region");
+                };
+            }
+            tets.push(out);
+        }
+        let want: HashSet<[u32; 3]> = self.faces.iter().map(|&f| canon(f)).collect();
+        if bound != want {
+            return Err("the filled region's boundary is not the surface");
+        }
+        Ok(Filled { pts, tets })
+    }
+
+    fn chains_or_inner_has(&self, v: u32) -> bool {
+        self.inner.iter().any(|x| x.contains(&v)) || self.chains.values().any(|c| c.contains(&v))
+    }
+}
+
+/// A face with its smallest id first (same orientation).
+fn canon(f: [u32; 3]) -> [u32; 3] {
+    let r = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+    [f[r], f[(r + 1) % 3], f[(r + 2) % 3]]
+}
+
+/// Order directed edges x -> y into a polygon: a cycle, or a path closed by its chord
+/// (from the path's end back to its start).
+fn polygon(edges: &[[u32; 2]]) -> Option<Vec<u32>> {
+    let next: HashMap<u32, u32> = edges.iter().map(|e| (e[0], e[1])).collect();
+    if next.len() != edges.len() {
+        return None;
+    }
+    let heads: HashSet<u32> = edges.iter().map(|e| e[1]).collect();
+    let start = edges
+        .iter()
+        .map(|e| e[0])
+        .find(|v| !heads.contains(v))
+        .unwrap_or(edges[0][0]);
+    let mut poly = vec![start];
+    let mut v = start;
+    while let Some(&w) = next.get(&v) {
+        if w == start {
+            break;
+        }
+        poly.push(w);
+        if poly.len() > edges.len() + 1 {
+            return None;
+        }
+        v = w;
+    }
+    let closed = next.get(&v) == Some(&start);
+    (poly.len() == edges.len() + usize::from(!closed)).then_some(poly)
+}
+
+/// Ear clipping of a simple polygon; `ccw(a, b, c)` is the exact test that a triangle
+/// turns the polygon's way. An ear contains no other polygon vertex (closed test).
+fn ear_clip(poly: &[u32], ccw: impl Fn(u32, u32, u32) -> bool) -> Option<Vec<[u32; 3]>> {
+    let mut p = poly.to_vec();
+    let mut out = Vec::new();
+    while p.len() > 3 {
+        let m = p.len();
+        let ear = (0..m).find(|&i| {
+            let (a, b, c) = (p[(i + m - 1) % m], p[i], p[(i + 1) % m]);
+            ccw(a, b, c)
+                && p.iter().all(|&x| {
+                    [a, b, c].contains(&x) || !(!ccw(b, a, x) && !ccw(c, b, x) && !ccw(a, c, x))
+                })
+        })?;
+        let (a, b, c) = (p[(ear + m - 1) % m], p[ear], p[(ear + 1) % m]);
+        out.push([a, b, c]);
+        p.remove(ear);
+    }
+    if p.len() == 3 {
+        if !ccw(p[0], p[1], p[2]) {
+            return None;
+        }
+        out.push([p[0], p[1], p[2]]);
+    }
+    Some(out)
+}
+
+/// Where segment ab meets the plane of `f` (rounded).
+fn segment_plane(a: P3, b: P3, f: [P3; 3]) -> P3 {
+    let da = tet_det(f[0], f[1], f[2], a);
+    let db = tet_det(f[0], f[1], f[2], b);
+    let t = if da == db { 0.5 } else { da / (da - db) };
+    axpy(a, t.clamp(0.0, 1.0), sub(b, a))
+}
+
+/// Distance from `p` to the line through x and y.
+fn line_dist(p: P3, x: P3, y: P3) -> f64 {
+    let d = sub(y, x);
+    norm(super::vec3::cross(d, sub(p, x))) / norm(d).max(f64::MIN_POSITIVE)
+}
+
+/// The point of edge xy closest to the line through a and b (rounded).
+fn segment_line(a: P3, b: P3, x: P3, y: P3) -> P3 {
+    let d1 = sub(b, a);
+    let d2 = sub(y, x);
+    let r = sub(a, x);
+    let (aa, ee, bb) = (dot(d1, d1), dot(d2, d2), dot(d1, d2));
+    let (cc, ff) = (dot(d1, r), dot(d2, r));
+    let den = aa * ee - bb * bb;
+    let t = if den.abs() > 0.0 {
+        (aa * ff - bb * cc) / den
+    } else {
+        0.5
+    };
+    axpy(x, t.clamp(0.0, 1.0), d2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fill `faces` (outward, as surfaces are stored) and check the result: positive tets,
+    /// boundary exactly the input, volume the enclosed one.
+    pub(crate) fn fill_and_check(pts: &[P3], outward: &[[u32; 3]]) -> Result<Filled, String> {
+        let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        let r = fill(pts, &faces).map_err(|e| e.to_string())?;
+        assert_eq!(&r.pts[..pts.len()], pts);
+        let mut vol = 0.0;
+        let mut uses: HashMap<[u32; 3], i32> = HashMap::new();
+        for t in &r.tets {
+            let p = t.map(|v| r.pts[v as usize]);
+            assert!(orient3d(p[0], p[1], p[2], p[3]) > 0);
+            vol += tet_det(p[0], p[1], p[2], p[3]) / 6.0;
+            for fk in FACES {
+                let g = fk.map(|j| t[j]);
+                *uses.entry(canon(g)).or_insert(0) += 1;
+                *uses.entry(canon([g[0], g[2], g[1]])).or_insert(0) -= 1;
+            }
+        }
+        // Faces used once and not matched by an opposite use: the outward boundary.
+        let bound: HashSet<[u32; 3]> = uses
+            .iter()
+            .filter(|(_, &n)| n == 1)
+            .map(|(f, _)| *f)
+            .collect();
+        let want: HashSet<[u32; 3]> = outward.iter().map(|&f| canon(f)).collect();
+        assert_eq!(bound, want);
+        let enclosed: f64 = outward
+            .iter()
+            .map(|f| {
+                super::super::vec3::det3(pts[f[0] as usize], pts[f[1] as usize], pts[f[2] as usize])
+                    / 6.0
+            })
+            .sum();
+        assert!(
+            (vol - enclosed).abs() <= 1e-9 * enclosed.abs(),
+            "{vol} vs {enclosed}"
+        );
+        Ok(r)
+    }
+
+    fn cube() -> (Vec<P3>, Vec<[u32; 3]>) {
+        let mut pts = Vec::new();
+        for i in 0..8 {
+            pts.push([(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]);
+        }
+        // Outward quads split into triangles.
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let mut f = Vec::new();
+        for q in quads {
+            f.push([q[0], q[1], q[2]]);
+            f.push([q[0], q[2], q[3]]);
+        }
+        (pts, f)
+    }
+
+    #[test]
+    fn a_cube_fills_with_its_own_vertices() {
+        let (p, f) = cube();
+        let r = fill_and_check(&p, &f).unwrap();
+        assert!(r.tets.len() >= 5);
+    }
+
+    /// Schönhardt's twisted prism: no tetrahedralization without an added point.
+    #[test]
+    fn the_schoenhardt_prism_fills_with_an_interior_point() {
+        let mut p = Vec::new();
+        for (z, twist) in [(0.0, 0.0), (1.0, 0.5)] {
+            for k in 0..3 {
+                let a =
+                    (k as f64 * 120.0f64 + if z > 0.0 { twist * 60.0 } else { 0.0 }).to_radians();
+                p.push([a.cos(), a.sin(), z]);
+            }
+        }
+        // Bottom (outward down), top (up), and each side quad split along the
+        // reflex diagonal.
+        let mut f = vec![[0, 2, 1], [3, 4, 5]];
+        for k in 0..3 {
+            let (a, b) = (k, (k + 1) % 3);
+            let (c, d) = (3 + k, 3 + (k + 1) % 3);
+            f.push([a, b, d]);
+            f.push([a, d, c]);
+        }
+        let r = fill_and_check(&p, &f);
+        // The twist makes one of the two diagonals reflex; try the other split if
+        // this one is convex, the point is a fill that needs a Steiner point.
+        let r = r.or_else(|_| {
+            let mut g = vec![[0, 2, 1], [3, 4, 5]];
+            for k in 0..3 {
+                let (a, b) = (k, (k + 1) % 3);
+                let (c, d) = (3 + k, 3 + (k + 1) % 3);
+                g.push([a, b, c]);
+                g.push([b, d, c]);
+            }
+            fill_and_check(&p, &g)
+        });
+        let r = r.unwrap();
+        assert!(r.pts.len() > 6, "{} points", r.pts.len());
+    }
+
+    #[test]
+    fn proto_one() {
+        let Ok(f) = std::env::var("FILL_ONE") else {
+            return;
+        };
+        let s = crate::io::read_any_surface(std::path::Path::new(&f), &Default::default()).unwrap();
+        let corners = s.corner_nodes();
+        let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
+        let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
+        let faces: Vec<[u32; 3]> = s
+            .triangles()
+            .iter()
+            .map(|t| [local(t[0]), local(t[1]), local(t[2])])
+            .collect();
+        eprintln!("{:?}", fill_and_check(&pts, &faces).map(|r| r.tets.len()));
+    }
+
+    #[test]
+    fn proto_corpus() {
+        let dir = std::path::Path::new("/work/shared/data/openscad");
+        let Ok(rd) = std::fs::read_dir(dir) else {
+            return;
+        };
+        let mut names: Vec<_> = rd
+            .filter_map(|e| e.ok())
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "stl"))
+            .collect();
+        names.sort();
+        let mut ok = 0;
+        for p in &names {
+            let s = crate::io::read_any_surface(p, &Default::default()).unwrap();
+            let corners = s.corner_nodes();
+            let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
+            let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
+            let faces: Vec<[u32; 3]> = s
+                .triangles()
+                .iter()
+                .map(|t| [local(t[0]), local(t[1]), local(t[2])])
+                .collect();
+            let t0 = std::time::Instant::now();
+            let r = fill_and_check(&pts, &faces);
+            eprintln!(
+                "{:<36} {:>6} tris {:>8.3}s {}",
+                p.file_name().unwrap().to_string_lossy(),
+                faces.len(),
+                t0.elapsed().as_secs_f64(),
+                match &r {
+                    Ok(f) => format!(
+                        "ok {} tets {} new pts",
+                        f.tets.len(),
+                        f.pts.len() - pts.len()
+                    ),
+                    Err(e) => format!("FAIL {e}"),
+                }
+            );
+            ok += r.is_ok() as usize;
+        }
+        eprintln!("filled {ok} of {}", names.len());
+    }
+}

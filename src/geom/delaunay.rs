@@ -1,0 +1,947 @@
+//! Incremental Delaunay tetrahedralization (Bowyer–Watson) with exact predicates, the
+//! kernel of the constrained fill that closes what the advancing front cannot.
+//!
+//! Points are inserted one at a time into a triangulation of a large enclosing tetrahedron:
+//! the tet containing the point is found by a visibility walk (which terminates on a
+//! Delaunay triangulation), the cavity of tets whose circumsphere strictly contains the
+//! point is removed, and its boundary is connected to the point. Every decision is an
+//! exact orient3d or insphere; the strict insphere test keeps every new tet's volume
+//! positive even on cospherical input (the triangulation is then one of the Delaunay
+//! ones). Neighbour links are kept so that later stages (boundary recovery by flips) can
+//! work locally.
+
+use super::predicates::orient3d;
+use super::vec3::P3;
+use std::collections::{HashMap, HashSet};
+
+/// No tet (a hull face's outer neighbour).
+pub(crate) const NONE: u32 = u32::MAX;
+
+/// Local faces of a tet: face `k` is opposite vertex `k`, ordered so that its normal
+/// (right hand) points out of a positively oriented tet.
+pub(crate) const FACES: [[usize; 3]; 4] = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+
+/// Insphere for a positively oriented tet (`orient3d(a, b, c, d) > 0`): > 0 when `e` is
+/// strictly inside its circumsphere, 0 on it, < 0 outside.
+pub(crate) fn insphere(a: P3, b: P3, c: P3, d: P3, e: P3) -> i32 {
+    // Shewchuk's insphere assumes his orientation, the opposite of ours: negate.
+    let v = robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e));
+    if v < 0.0 {
+        1
+    } else if v > 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+fn c3(p: P3) -> robust::Coord3D<f64> {
+    robust::Coord3D {
+        x: p[0],
+        y: p[1],
+        z: p[2],
+    }
+}
+
+/// A Delaunay tetrahedralization of `pts` (the first `n` points, the input) plus four
+/// enclosing points (ids `n..n + 4`).
+pub(crate) struct Delaunay {
+    pub pts: Vec<P3>,
+    /// Number of input points (the enclosing ones follow).
+    pub n: usize,
+    pub tets: Vec<[u32; 4]>,
+    /// `adj[t][k]`: the tet across face `k` (opposite vertex `k`) of tet `t`, or [`NONE`].
+    pub adj: Vec<[u32; 4]>,
+    pub alive: Vec<bool>,
+    /// A live tet containing each point (kept by every change; [`NONE`] before the point
+    /// is in a tet).
+    vt: Vec<u32>,
+    /// Edges (sorted ids) that no flip may remove: recovered constraint edges.
+    pub fixed_edges: HashSet<[u32; 2]>,
+    /// Faces (sorted ids) that no flip may remove: recovered constraint faces.
+    pub fixed_faces: HashSet<[u32; 3]>,
+    last: u32,
+}
+
+impl Delaunay {
+    /// The Delaunay tetrahedralization of `pts` (inserted in the given order; duplicates
+    /// are skipped: they never appear in a tet).
+    pub(crate) fn new(pts: &[P3]) -> Delaunay {
+        let n = pts.len();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in pts {
+            for d in 0..3 {
+                lo[d] = lo[d].min(p[d]);
+                hi[d] = hi[d].max(p[d]);
+            }
+        }
+        if n == 0 {
+            lo = [0.0; 3];
+            hi = [1.0; 3];
+        }
+        let c = [0, 1, 2].map(|d| 0.5 * (lo[d] + hi[d]));
+        let r = (0..3).map(|d| hi[d] - lo[d]).fold(1e-300, f64::max) * 1e3;
+        // A regular-ish tetrahedron far larger than the box (exact predicates make the
+        // distance harmless).
+        let far = [
+            [c[0] + r, c[1] + r, c[2] + r],
+            [c[0] + r, c[1] - r, c[2] - r],
+            [c[0] - r, c[1] + r, c[2] - r],
+            [c[0] - r, c[1] - r, c[2] + r],
+        ];
+        let mut all = pts.to_vec();
+        all.extend_from_slice(&far);
+        let s = n as u32;
+        let mut t = [s, s + 1, s + 2, s + 3];
+        if orient3d(
+            all[t[0] as usize],
+            all[t[1] as usize],
+            all[t[2] as usize],
+            all[t[3] as usize],
+        ) < 0
+        {
+            t.swap(2, 3);
+        }
+        let mut vt = vec![NONE; all.len()];
+        for &v in &t {
+            vt[v as usize] = 0;
+        }
+        let mut dt = Delaunay {
+            pts: all,
+            n,
+            tets: vec![t],
+            adj: vec![[NONE; 4]],
+            alive: vec![true],
+            vt,
+            fixed_edges: HashSet::new(),
+            fixed_faces: HashSet::new(),
+            last: 0,
+        };
+        for i in 0..n as u32 {
+            dt.insert(i);
+        }
+        dt
+    }
+
+    pub(crate) fn p(&self, v: u32) -> P3 {
+        self.pts[v as usize]
+    }
+
+    /// The tet containing point `q` (closed), by a visibility walk from the last tet made.
+    fn locate(&self, q: P3) -> u32 {
+        let mut t = self.last;
+        if !self.alive[t as usize] {
+            t = self.alive.iter().position(|&a| a).unwrap_or(0) as u32;
+        }
+        // Bounded for safety; a walk in a Delaunay triangulation terminates.
+        for _ in 0..4 * self.tets.len() + 16 {
+            let tv = self.tets[t as usize];
+            let mut moved = false;
+            for (k, f) in FACES.iter().enumerate() {
+                let (a, b, c) = (self.p(tv[f[0]]), self.p(tv[f[1]]), self.p(tv[f[2]]));
+                // q strictly outside face k (on the side its outward normal points to).
+                if orient3d(a, b, c, q) > 0 {
+                    let nb = self.adj[t as usize][k];
+                    if nb != NONE {
+                        t = nb;
+                        moved = true;
+                        break;
+                    }
+                }
+            }
+            if !moved {
+                return t;
+            }
+        }
+        // Fall back to a scan (never expected).
+        (0..self.tets.len() as u32)
+            .find(|&t| {
+                self.alive[t as usize] && {
+                    let tv = self.tets[t as usize];
+                    FACES.iter().all(|f| {
+                        orient3d(self.p(tv[f[0]]), self.p(tv[f[1]]), self.p(tv[f[2]]), q) <= 0
+                    })
+                }
+            })
+            .unwrap_or(t)
+    }
+
+    fn in_sphere(&self, t: u32, q: P3) -> i32 {
+        let v = self.tets[t as usize];
+        insphere(self.p(v[0]), self.p(v[1]), self.p(v[2]), self.p(v[3]), q)
+    }
+
+    /// Insert input point `i`. False if it coincides with a point already there.
+    pub(crate) fn insert(&mut self, i: u32) -> bool {
+        let q = self.p(i);
+        let start = self.locate(q);
+        if self.tets[start as usize].iter().any(|&v| self.p(v) == q) {
+            return false;
+        }
+        // The cavity: tets whose circumsphere strictly contains q, grown from `start`
+        // (which contains q, so its sphere does unless q is on it: then it is still
+        // removed, as q lies in it).
+        let mut cavity = vec![start];
+        let mut in_cav: HashMap<u32, ()> = HashMap::new();
+        in_cav.insert(start, ());
+        let mut k = 0;
+        while k < cavity.len() {
+            let t = cavity[k];
+            k += 1;
+            for j in 0..4 {
+                let nb = self.adj[t as usize][j];
+                if nb != NONE && !in_cav.contains_key(&nb) && self.in_sphere(nb, q) > 0 {
+                    in_cav.insert(nb, ());
+                    cavity.push(nb);
+                }
+            }
+        }
+        // Boundary faces of the cavity -> new tets (face, q).
+        let mut edge_of: HashMap<(u32, u32), (u32, usize)> = HashMap::new();
+        let mut made = Vec::new();
+        for &t in &cavity {
+            let tv = self.tets[t as usize];
+            for (j, f) in FACES.iter().enumerate() {
+                let nb = self.adj[t as usize][j];
+                if nb != NONE && in_cav.contains_key(&nb) {
+                    continue;
+                }
+                // New tet: (f0, f1, f2, q) with f's outward normal pointing at q? The face
+                // normal points out of t, and q is inside the cavity: q is on the inner
+                // side, so (f0, f2, f1, q) is positive.
+                let a = tv[f[0]];
+                let b = tv[f[2]];
+                let c = tv[f[1]];
+                let nt = self.tets.len() as u32;
+                self.tets.push([a, b, c, i]);
+                // Face 3 (opposite q) is (a, b, c) -> outer neighbour nb.
+                self.adj.push([NONE, NONE, NONE, nb]);
+                self.alive.push(true);
+                if nb != NONE {
+                    let back = (0..4).find(|&m| self.adj[nb as usize][m] == t).unwrap_or(0);
+                    self.adj[nb as usize][back] = nt;
+                }
+                // Faces 0, 1, 2 of the new tet contain q and the edge opposite a, b, c.
+                let tvn = [a, b, c];
+                for m in 0..3 {
+                    let e0 = tvn[(m + 1) % 3];
+                    let e1 = tvn[(m + 2) % 3];
+                    let key = if e0 < e1 { (e0, e1) } else { (e1, e0) };
+                    if let Some((ot, om)) = edge_of.remove(&key) {
+                        self.adj[nt as usize][m] = ot;
+                        self.adj[ot as usize][om] = nt;
+                    } else {
+                        edge_of.insert(key, (nt, m));
+                    }
+                }
+                made.push(nt);
+            }
+        }
+        for &t in &cavity {
+            self.alive[t as usize] = false;
+        }
+        for &t in &made {
+            for v in self.tets[t as usize] {
+                self.vt[v as usize] = t;
+            }
+        }
+        self.last = *made.last().unwrap_or(&start);
+        true
+    }
+
+    /// Live tets whose four vertices are all input points.
+    pub(crate) fn interior_tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
+        let n = self.n as u32;
+        (0..self.tets.len())
+            .filter(move |&t| self.alive[t] && self.tets[t].iter().all(|&v| v < n))
+            .map(move |t| self.tets[t])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rng(seed: &mut u64) -> f64 {
+        *seed ^= *seed << 13;
+        *seed ^= *seed >> 7;
+        *seed ^= *seed << 17;
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn check_delaunay(dt: &Delaunay) {
+        let live: Vec<usize> = (0..dt.tets.len()).filter(|&t| dt.alive[t]).collect();
+        for &t in &live {
+            let v = dt.tets[t];
+            let p = v.map(|x| dt.pts[x as usize]);
+            assert!(orient3d(p[0], p[1], p[2], p[3]) > 0, "tet {t} not positive");
+            // Empty circumsphere against every point.
+            for (i, &q) in dt.pts.iter().enumerate() {
+                if v.contains(&(i as u32)) {
+                    continue;
+                }
+                assert!(
+                    insphere(p[0], p[1], p[2], p[3], q) <= 0,
+                    "point {i} in tet {t}'s sphere"
+                );
+            }
+            // Links are mutual and across the same face.
+            for k in 0..4 {
+                let nb = dt.adj[t][k];
+                if nb == NONE {
+                    continue;
+                }
+                assert!(dt.alive[nb as usize]);
+                let mut f: Vec<u32> = FACES[k].iter().map(|&j| v[j]).collect();
+                f.sort_unstable();
+                let w = dt.tets[nb as usize];
+                assert!(f.iter().all(|x| w.contains(x)));
+                assert!(dt.adj[nb as usize].contains(&(t as u32)));
+            }
+        }
+        // The tets fill the enclosing tet: volumes add up.
+        let vol = |v: [u32; 4]| {
+            let p = v.map(|x| dt.pts[x as usize]);
+            crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3])
+        };
+        let total: f64 = live.iter().map(|&t| vol(dt.tets[t])).sum();
+        let n = dt.n as u32;
+        let outer = vol([n, n + 1, n + 2, n + 3]).abs();
+        assert!((total - outer).abs() <= 1e-9 * outer, "{total} vs {outer}");
+    }
+
+    #[test]
+    fn insphere_sign_matches_our_orientation() {
+        let a = [0.0, 0.0, 0.0];
+        let b = [1.0, 0.0, 0.0];
+        let c = [0.0, 1.0, 0.0];
+        let d = [0.0, 0.0, 1.0];
+        assert!(orient3d(a, b, c, d) > 0);
+        assert_eq!(insphere(a, b, c, d, [0.2, 0.2, 0.2]), 1);
+        assert_eq!(insphere(a, b, c, d, [5.0, 5.0, 5.0]), -1);
+        assert_eq!(insphere(a, b, c, d, [1.0, 1.0, 0.0]), 0);
+    }
+
+    #[test]
+    fn random_points_give_an_empty_sphere_triangulation() {
+        let mut s = 0x9e3779b97f4a7c15u64;
+        let pts: Vec<P3> = (0..200)
+            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
+            .collect();
+        let dt = Delaunay::new(&pts);
+        check_delaunay(&dt);
+        assert!(dt.interior_tets().count() > 200);
+    }
+
+    #[test]
+    fn grid_points_cospherical_and_duplicates() {
+        // A 4 x 4 x 4 lattice: every cube's 8 corners are cospherical.
+        let mut pts = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                for k in 0..4 {
+                    pts.push([i as f64, j as f64, k as f64]);
+                }
+            }
+        }
+        pts.push([1.0, 1.0, 1.0]);
+        let dt = Delaunay::new(&pts);
+        check_delaunay(&dt);
+        // The lattice's 27 cubes, each of volume 1, are covered.
+        let vol: f64 = dt
+            .interior_tets()
+            .map(|v| {
+                let p = v.map(|x| dt.pts[x as usize]);
+                crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3]) / 6.0
+            })
+            .sum();
+        assert!((vol - 27.0).abs() < 1e-9, "{vol}");
+        assert!(dt.interior_tets().all(|t| !t.contains(&64)));
+    }
+}
+
+/// A constraint face or edge a tetrahedralization lacks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Missing {
+    /// An edge of a constraint face (local point ids).
+    Edge([u32; 2]),
+    /// Constraint face `i` (its edges are all there).
+    Face(usize),
+}
+
+impl Delaunay {
+    /// The first edge, then the first face, of `faces` (local point ids) that is not in
+    /// the triangulation.
+    pub(crate) fn first_missing(&self, faces: &[[u32; 3]]) -> Option<Missing> {
+        let mut edges = std::collections::HashSet::new();
+        let mut tris = std::collections::HashSet::new();
+        for (t, v) in self.tets.iter().enumerate() {
+            if !self.alive[t] {
+                continue;
+            }
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    edges.insert(sorted2(v[i], v[j]));
+                }
+                tris.insert(sorted3(FACES[i].map(|k| v[k])));
+            }
+        }
+        for f in faces {
+            for k in 0..3 {
+                let e = sorted2(f[k], f[(k + 1) % 3]);
+                if !edges.contains(&e) {
+                    return Some(Missing::Edge(e));
+                }
+            }
+        }
+        faces
+            .iter()
+            .position(|f| !tris.contains(&sorted3(*f)))
+            .map(Missing::Face)
+    }
+
+    /// The tets enclosed by `faces` (local ids; every face in the triangulation, oriented
+    /// with its normal into the enclosed region): those reached from the faces' inner
+    /// sides without crossing a face. None if an enclosing point is reached (the faces do
+    /// not enclose).
+    pub(crate) fn enclosed(&self, faces: &[[u32; 3]]) -> Option<Vec<[u32; 4]>> {
+        let walls: std::collections::HashSet<[u32; 3]> =
+            faces.iter().map(|f| sorted3(*f)).collect();
+        let mut by_face: HashMap<[u32; 3], (u32, usize)> = HashMap::new();
+        for (t, v) in self.tets.iter().enumerate() {
+            if self.alive[t] {
+                for (k, f) in FACES.iter().enumerate() {
+                    // Keyed by the face as seen from inside tet t (outward order reversed).
+                    by_face.insert([v[f[0]], v[f[2]], v[f[1]]], (t as u32, k));
+                }
+            }
+        }
+        let mut inside = vec![false; self.tets.len()];
+        let mut stack = Vec::new();
+        for f in faces {
+            // The tet on f's inner side sees f with f's own orientation reversed... the
+            // tet t whose outward face is (f0, f2, f1) has f's normal pointing into t.
+            let key = rotations(*f);
+            let hit = key.iter().find_map(|k| by_face.get(k));
+            let (t, _) = *hit?;
+            if !inside[t as usize] {
+                inside[t as usize] = true;
+                stack.push(t);
+            }
+        }
+        while let Some(t) = stack.pop() {
+            let v = self.tets[t as usize];
+            if v.iter().any(|&x| x as usize >= self.n) {
+                return None;
+            }
+            for (k, f) in FACES.iter().enumerate() {
+                if walls.contains(&sorted3(f.map(|j| v[j]))) {
+                    continue;
+                }
+                let nb = self.adj[t as usize][k];
+                if nb == NONE {
+                    return None;
+                }
+                if !inside[nb as usize] {
+                    inside[nb as usize] = true;
+                    stack.push(nb);
+                }
+            }
+        }
+        Some(
+            (0..self.tets.len())
+                .filter(|&t| inside[t])
+                .map(|t| self.tets[t])
+                .collect(),
+        )
+    }
+}
+
+fn rotations(f: [u32; 3]) -> [[u32; 3]; 3] {
+    [f, [f[1], f[2], f[0]], [f[2], f[0], f[1]]]
+}
+
+pub(crate) fn sorted2(a: u32, b: u32) -> [u32; 2] {
+    if a < b {
+        [a, b]
+    } else {
+        [b, a]
+    }
+}
+
+pub(crate) fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
+    f.sort_unstable();
+    f
+}
+
+impl Delaunay {
+    /// Replace live tets `old` by tets `new` (each positively oriented) covering the same
+    /// region, relinking neighbours. Returns the new tets' ids. A new face that matches
+    /// no outer face of `old` gets no neighbour (the fill's boundary changes that way when
+    /// it moves a Steiner point off a constraint face).
+    pub(crate) fn replace(&mut self, old: &[u32], new: &[[u32; 4]]) -> Vec<u32> {
+        let mut outer: HashMap<[u32; 3], (u32, usize)> = HashMap::new();
+        let olds: std::collections::HashSet<u32> = old.iter().copied().collect();
+        for &t in old {
+            let v = self.tets[t as usize];
+            for (k, f) in FACES.iter().enumerate() {
+                let nb = self.adj[t as usize][k];
+                if nb != NONE && olds.contains(&nb) {
+                    continue;
+                }
+                let key = sorted3(f.map(|j| v[j]));
+                let back = if nb == NONE {
+                    usize::MAX
+                } else {
+                    (0..4)
+                        .find(|&m| self.adj[nb as usize][m] == t)
+                        .unwrap_or(usize::MAX)
+                };
+                outer.insert(key, (nb, back));
+            }
+            self.alive[t as usize] = false;
+        }
+        let mut inner: HashMap<[u32; 3], (u32, usize)> = HashMap::new();
+        let mut ids = Vec::with_capacity(new.len());
+        for &v in new {
+            let nt = self.tets.len() as u32;
+            self.tets.push(v);
+            self.adj.push([NONE; 4]);
+            self.alive.push(true);
+            for (k, f) in FACES.iter().enumerate() {
+                let key = sorted3(f.map(|j| v[j]));
+                if let Some((nb, back)) = outer.remove(&key) {
+                    self.adj[nt as usize][k] = nb;
+                    if nb != NONE && back != usize::MAX {
+                        self.adj[nb as usize][back] = nt;
+                    }
+                } else if let Some((ot, ok)) = inner.remove(&key) {
+                    self.adj[nt as usize][k] = ot;
+                    self.adj[ot as usize][ok] = nt;
+                } else {
+                    inner.insert(key, (nt, k));
+                }
+            }
+            ids.push(nt);
+        }
+        for &t in &ids {
+            for v in self.tets[t as usize] {
+                self.vt[v as usize] = t;
+            }
+        }
+        self.last = *ids.last().unwrap_or(&self.last);
+        ids
+    }
+
+    pub(crate) fn positive(&self, t: [u32; 4]) -> bool {
+        orient3d(self.p(t[0]), self.p(t[1]), self.p(t[2]), self.p(t[3])) > 0
+    }
+
+    /// 2-3 flip of tet `t` and its neighbour across face `k`: the edge between their
+    /// apexes replaces the face. False (nothing changed) unless the union is convex there.
+    pub(crate) fn flip23(&mut self, t: u32, k: usize) -> bool {
+        let u = self.adj[t as usize][k];
+        if u == NONE {
+            return false;
+        }
+        let tv = self.tets[t as usize];
+        if self.fixed_faces.contains(&sorted3(FACES[k].map(|j| tv[j]))) {
+            return false;
+        }
+        let a = tv[k];
+        let f = FACES[k].map(|j| tv[j]); // outward from t: (p, q, r)
+        let uv = self.tets[u as usize];
+        let Some(&b) = uv.iter().find(|x| !f.contains(x)) else {
+            return false;
+        };
+        // New tets (p, q, a, b)... each (edge of f, a, b) with positive orientation.
+        let new = [[f[0], f[1], a, b], [f[1], f[2], a, b], [f[2], f[0], a, b]];
+        if !new.iter().all(|&n| self.positive(n)) {
+            return false;
+        }
+        self.replace(&[t, u], &new);
+        true
+    }
+
+    /// 3-2 flip of the edge (a, b) when exactly three live tets share it: the triangle of
+    /// their other vertices replaces the edge. False unless that is valid.
+    pub(crate) fn flip32(&mut self, a: u32, b: u32, around: &[u32]) -> bool {
+        if around.len() != 3 || self.fixed_edges.contains(&sorted2(a, b)) {
+            return false;
+        }
+        let mut others: Vec<u32> = Vec::new();
+        for &t in around {
+            for &x in &self.tets[t as usize] {
+                if x != a && x != b && !others.contains(&x) {
+                    others.push(x);
+                }
+            }
+        }
+        if others.len() != 3 {
+            return false;
+        }
+        let (p, q, r) = (others[0], others[1], others[2]);
+        let mut t1 = [p, q, r, a];
+        let mut t2 = [p, q, r, b];
+        if !self.positive(t1) {
+            t1.swap(0, 1);
+        }
+        if !self.positive(t2) {
+            t2.swap(0, 1);
+        }
+        if !self.positive(t1) || !self.positive(t2) {
+            return false;
+        }
+        // a and b on opposite sides of (p, q, r) (else the two tets overlap).
+        if orient3d(self.p(p), self.p(q), self.p(r), self.p(a))
+            == orient3d(self.p(p), self.p(q), self.p(r), self.p(b))
+        {
+            return false;
+        }
+        self.replace(around, &[t1, t2]);
+        true
+    }
+
+    /// Edge removal (n-to-2n-4 flip): replace the `around` tets sharing edge (x, y) by
+    /// tets on a fan triangulation of their ring of other vertices, joined to x and to y,
+    /// trying a fan from each ring vertex. False (nothing changed) if none is valid.
+    pub(crate) fn remove_edge(&mut self, x: u32, y: u32, around: &[u32]) -> bool {
+        let n = around.len();
+        if !(3..=10).contains(&n) || self.fixed_edges.contains(&sorted2(x, y)) {
+            return false;
+        }
+        // Each tet contributes the ring edge of its two other vertices; chain them.
+        let mut links: Vec<[u32; 2]> = Vec::with_capacity(n);
+        for &t in around {
+            let o: Vec<u32> = self.tets[t as usize]
+                .iter()
+                .copied()
+                .filter(|&v| v != x && v != y)
+                .collect();
+            if o.len() != 2 {
+                return false;
+            }
+            links.push([o[0], o[1]]);
+        }
+        let mut ring = vec![links[0][0], links[0][1]];
+        let mut used = vec![false; n];
+        used[0] = true;
+        while ring.len() < n {
+            let last = *ring.last().unwrap_or(&NONE);
+            let Some(j) = (0..n).find(|&j| !used[j] && links[j].contains(&last)) else {
+                return false;
+            };
+            used[j] = true;
+            let next = if links[j][0] == last {
+                links[j][1]
+            } else {
+                links[j][0]
+            };
+            ring.push(next);
+        }
+        // The ring closes back to its start.
+        let Some(j) = (0..n).find(|&j| !used[j]) else {
+            return false;
+        };
+        if !(links[j].contains(&ring[0]) && links[j].contains(&ring[n - 1])) {
+            return false;
+        }
+        for apex in 0..n {
+            let mut new = Vec::with_capacity(2 * (n - 2));
+            for k in 1..n - 1 {
+                let a = ring[apex];
+                let b = ring[(apex + k) % n];
+                let c = ring[(apex + k + 1) % n];
+                for top in [x, y] {
+                    let mut t = [a, b, c, top];
+                    if !self.positive(t) {
+                        t.swap(0, 1);
+                    }
+                    new.push(t);
+                }
+            }
+            if new.iter().all(|&t| self.positive(t))
+                && (1..n - 1).all(|k| {
+                    // x and y on opposite sides of each fan triangle.
+                    let a = self.p(ring[apex]);
+                    let b = self.p(ring[(apex + k) % n]);
+                    let c = self.p(ring[(apex + k + 1) % n]);
+                    orient3d(a, b, c, self.p(x)) == -orient3d(a, b, c, self.p(y))
+                })
+            {
+                // Volumes must match the old ones (no overlap): check exactly by sign sum
+                // is not possible; compare floating volumes as a guard.
+                let vol = |t: &[u32; 4]| {
+                    let p = t.map(|v| self.p(v));
+                    super::vec3::tet_det(p[0], p[1], p[2], p[3])
+                };
+                let old: f64 = around.iter().map(|&t| vol(&self.tets[t as usize])).sum();
+                let newv: f64 = new.iter().map(vol).sum();
+                if (old - newv).abs() <= 1e-9 * old.abs() {
+                    self.replace(around, &new);
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// Live tets containing vertex `v`: a walk across the faces through `v` from the tet
+    /// [`Delaunay::vt`] keeps for it.
+    pub(crate) fn star(&self, v: u32) -> Vec<u32> {
+        let t0 = self.vt.get(v as usize).copied().unwrap_or(NONE);
+        if t0 == NONE || !self.alive[t0 as usize] || !self.tets[t0 as usize].contains(&v) {
+            // Not expected (every change keeps `vt`); a scan is always right.
+            return (0..self.tets.len() as u32)
+                .filter(|&t| self.alive[t as usize] && self.tets[t as usize].contains(&v))
+                .collect();
+        }
+        let mut out = vec![t0];
+        let mut k = 0;
+        while k < out.len() {
+            let t = out[k];
+            k += 1;
+            let tv = self.tets[t as usize];
+            for j in 0..4 {
+                if tv[j] == v {
+                    continue;
+                }
+                let nb = self.adj[t as usize][j];
+                if nb != NONE && !out.contains(&nb) {
+                    out.push(nb);
+                }
+            }
+        }
+        out
+    }
+
+    /// Rebuild the point-to-tet map from the live tets (after tets are dropped).
+    pub(crate) fn rebuild_vt(&mut self) {
+        self.vt = vec![NONE; self.pts.len()];
+        for t in 0..self.tets.len() {
+            if self.alive[t] {
+                for v in self.tets[t] {
+                    self.vt[v as usize] = t as u32;
+                }
+            }
+        }
+    }
+
+    /// A new point (not yet in any tet).
+    pub(crate) fn add_point(&mut self, p: P3) -> u32 {
+        self.pts.push(p);
+        self.vt.push(NONE);
+        (self.pts.len() - 1) as u32
+    }
+
+    /// Is (a, b) an edge of a live tet?
+    pub(crate) fn has_edge(&self, a: u32, b: u32) -> bool {
+        self.star(a)
+            .iter()
+            .any(|&t| self.tets[t as usize].contains(&b))
+    }
+
+    /// The live tets around edge (x, y).
+    pub(crate) fn around_edge(&self, x: u32, y: u32) -> Vec<u32> {
+        self.star(x)
+            .into_iter()
+            .filter(|&t| self.tets[t as usize].contains(&y))
+            .collect()
+    }
+
+    /// Replace each tet of `old` by copies with one of its vertices in `which` replaced by
+    /// the new point `p` (a split of those tets at `p`). Unless every new tet is positive,
+    /// nothing changes and Err lists the old tets that would give a non-positive one (a
+    /// rounded point next to a nearly flat tet).
+    fn split_at(&mut self, old: &[u32], which: &[Vec<u32>], p: P3) -> Result<u32, Vec<u32>> {
+        let s = self.add_point(p);
+        let mut new = Vec::new();
+        let mut bad = Vec::new();
+        for (&t, w) in old.iter().zip(which) {
+            let tv = self.tets[t as usize];
+            for &x in w {
+                let nt = tv.map(|v| if v == x { s } else { v });
+                if self.positive(nt) {
+                    new.push(nt);
+                } else if !bad.contains(&t) {
+                    bad.push(t);
+                }
+            }
+        }
+        if !bad.is_empty() {
+            self.pts.pop();
+            self.vt.pop();
+            return Err(bad);
+        }
+        self.replace(old, &new);
+        Ok(s)
+    }
+
+    /// Split face `k` of tet `t` (and the tet behind it) at `p`, 2 tets to 6.
+    pub(crate) fn split_face(&mut self, t: u32, k: usize, p: P3) -> Result<u32, Vec<u32>> {
+        let u = self.adj[t as usize][k];
+        let f = FACES[k].map(|j| self.tets[t as usize][j]);
+        if u == NONE || self.fixed_faces.contains(&sorted3(f)) {
+            return Err(Vec::new());
+        }
+        let w = f.to_vec();
+        self.split_at(&[t, u], &[w.clone(), w], p)
+    }
+
+    /// Split edge (x, y) at `p`: each tet around it becomes two.
+    pub(crate) fn split_edge(&mut self, x: u32, y: u32, p: P3) -> Result<u32, Vec<u32>> {
+        if self.fixed_edges.contains(&sorted2(x, y)) {
+            return Err(Vec::new());
+        }
+        let around = self.around_edge(x, y);
+        if around.is_empty() {
+            return Err(Vec::new());
+        }
+        let which = vec![vec![x, y]; around.len()];
+        self.split_at(&around, &which, p)
+    }
+
+    /// Change the tets `bad` (nearly flat ones, in the way of a split) by any valid flip
+    /// that keeps the fixed edges and faces. True if something changed.
+    pub(crate) fn flip_away(&mut self, bad: &[u32]) -> bool {
+        for &t in bad {
+            if !self.alive[t as usize] {
+                continue;
+            }
+            for k in 0..4 {
+                if self.flip23(t, k) {
+                    return true;
+                }
+            }
+            let tv = self.tets[t as usize];
+            for i in 0..4 {
+                for j in i + 1..4 {
+                    let (x, y) = (tv[i], tv[j]);
+                    let around = self.around_edge(x, y);
+                    if self.flip32(x, y, &around) || self.remove_edge(x, y, &around) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// The tet at `a` that segment ab leaves `a` through, and its face opposite `a` (b is
+    /// on the inner side of, or on, each of the tet's faces through `a`).
+    pub(crate) fn leaving(&self, a: u32, b: u32) -> Option<(u32, usize)> {
+        let pb = self.p(b);
+        self.star(a).iter().find_map(|&t| {
+            let v = self.tets[t as usize];
+            let k = v.iter().position(|&x| x == a)?;
+            let ok = FACES.iter().enumerate().all(|(j, f)| {
+                j == k || orient3d(self.p(v[f[0]]), self.p(v[f[1]]), self.p(v[f[2]]), pb) <= 0
+            });
+            ok.then_some((t, k))
+        })
+    }
+
+    /// The faces segment ab crosses, walking from a's tet toward b: (tet, local face) in
+    /// order. Stops early (returns what it has) where the segment meets an edge or a
+    /// vertex (a degenerate crossing).
+    fn crossed_faces(&self, a: u32, b: u32) -> Vec<(u32, usize)> {
+        let (pa, pb) = (self.p(a), self.p(b));
+        let Some((mut t, mut k)) = self.leaving(a, b) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        for _ in 0..self.tets.len() {
+            out.push((t, k));
+            let nb = self.adj[t as usize][k];
+            if nb == NONE || self.tets[nb as usize].contains(&b) {
+                break;
+            }
+            // The exit face of nb: crossed strictly by ab, not the entry face.
+            let entry = (0..4).find(|&m| self.adj[nb as usize][m] == t).unwrap_or(4);
+            let v = self.tets[nb as usize];
+            let next = (0..4).find(|&m| {
+                if m == entry {
+                    return false;
+                }
+                let f = FACES[m].map(|j| self.p(v[j]));
+                let o = [
+                    orient3d(pa, pb, f[0], f[1]),
+                    orient3d(pa, pb, f[1], f[2]),
+                    orient3d(pa, pb, f[2], f[0]),
+                ];
+                (o.iter().all(|&x| x > 0) || o.iter().all(|&x| x < 0))
+                    && orient3d(f[0], f[1], f[2], pb) > 0
+            });
+            let Some(m) = next else {
+                break;
+            };
+            t = nb;
+            k = m;
+        }
+        out
+    }
+
+    /// [`Delaunay::recover_edge`] trying every face and edge segment ab crosses, not only
+    /// the first: 2-3 flips of crossed faces, then removal of their edges.
+    pub(crate) fn recover_edge_any(&mut self, a: u32, b: u32, budget: usize) -> bool {
+        'outer: for _ in 0..budget {
+            if self.has_edge(a, b) {
+                return true;
+            }
+            let crossed = self.crossed_faces(a, b);
+            for &(t, k) in &crossed {
+                if self.alive[t as usize] && self.flip23(t, k) {
+                    continue 'outer;
+                }
+            }
+            for &(t, k) in &crossed {
+                if !self.alive[t as usize] {
+                    continue;
+                }
+                let v = self.tets[t as usize];
+                let f = FACES[k].map(|j| v[j]);
+                for e in 0..3 {
+                    let (x, y) = (f[e], f[(e + 1) % 3]);
+                    if [x, y].contains(&a) || [x, y].contains(&b) {
+                        continue;
+                    }
+                    let around = self.around_edge(x, y);
+                    if self.remove_edge(x, y, &around) {
+                        continue 'outer;
+                    }
+                }
+            }
+            return false;
+        }
+        false
+    }
+
+    /// Try to make edge (a, b) appear by flips of what segment ab crosses next to `a`
+    /// (greedy; at most `budget` flips). True when the edge is there.
+    pub(crate) fn recover_edge(&mut self, a: u32, b: u32, budget: usize) -> bool {
+        for _ in 0..budget {
+            if self.has_edge(a, b) {
+                return true;
+            }
+            let Some((t, k)) = self.leaving(a, b) else {
+                return false;
+            };
+            if self.flip23(t, k) {
+                continue;
+            }
+            // Not convex across that face: try 3-2 flips and edge removals on its edges.
+            let v = self.tets[t as usize];
+            let f = FACES[k].map(|j| v[j]);
+            let flipped = (0..3).any(|e| {
+                let (x, y) = (f[e], f[(e + 1) % 3]);
+                let around = self.around_edge(x, y);
+                self.flip32(x, y, &around) || self.remove_edge(x, y, &around)
+            });
+            if !flipped {
+                return false;
+            }
+        }
+        false
+    }
+}
