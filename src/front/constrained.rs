@@ -7,6 +7,9 @@ use super::{key3, Mesher};
 use crate::geom::cdt_fill;
 use crate::geom::vec3::{tet_det, P3};
 
+/// Largest cavity (front faces) handed to the fill.
+pub(super) const MAX_FILL_FACES: usize = 1000;
+
 impl Mesher<'_> {
     /// Fill the cavity bounded by live front faces `comp`; `fixed` are the other live
     /// front faces nearby, which no new tet may touch. True when the tets are inserted.

@@ -595,8 +595,9 @@ impl<'a> Mesher<'a> {
                 continue;
             }
             // Stuck at every level: close its cavity exactly if it is small...
-            if let Some(comp) = self.component(fid, cavity::MAX_CAVITY_FACES) {
-                if self.fill_cavity(&comp) {
+            // ...or, where the search cannot, by the constrained fill...
+            if let Some(comp) = self.component(fid, constrained::MAX_FILL_FACES) {
+                if comp.len() <= cavity::MAX_CAVITY_FACES && self.fill_cavity(&comp) {
                     self.stats.cavities += 1;
                     continue;
                 }

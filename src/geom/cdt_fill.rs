@@ -71,6 +71,15 @@ impl<'a> Cdt<'a> {
         if used.iter().any(|&v| dt.star(v).is_empty()) {
             return Err("two surface points coincide");
         }
+        let mut dt = dt;
+        for f in faces {
+            for k in 0..3 {
+                dt.edge_faces
+                    .entry(sorted2(f[k], f[(k + 1) % 3]))
+                    .or_default()
+                    .push(sorted3(*f));
+            }
+        }
         Ok(Cdt {
             dt,
             faces,
@@ -125,6 +134,9 @@ impl<'a> Cdt<'a> {
             let fp = f.map(|v| self.dt.p(v));
             let (pc, pb) = (self.dt.p(cur), self.dt.p(b));
             let o = [0, 1, 2].map(|e| orient3d(pc, pb, fp[e], fp[(e + 1) % 3]));
+            // The new point's edge, known to the flatness test before the split.
+            let next = self.dt.next_id();
+            self.dt.on_line.insert(next, sorted2(a, b));
             let split = match o.iter().filter(|&&x| x == 0).count() {
                 0 => {
                     let p = segment_plane(pc, pb, fp);
@@ -158,6 +170,7 @@ impl<'a> Cdt<'a> {
             let s = match split {
                 Ok(s) => s,
                 Err(bad) => {
+                    self.dt.on_line.remove(&next);
                     // Nearly flat tets in the way: flip them and walk again.
                     flips += 1;
                     if flips <= MAX_UNBLOCK && self.dt.flip_away(&bad) {
@@ -228,13 +241,30 @@ impl<'a> Cdt<'a> {
                 }
             }
             let Some((u, v)) = crossing else {
-                break;
+                // A nearly flat tet with all four points on the face (rounded Steiner
+                // points): flip it away and look again.
+                let flat: Vec<u32> = near
+                    .iter()
+                    .copied()
+                    .filter(|&t| self.dt.tets[t as usize].iter().all(|v| on.contains(v)))
+                    .collect();
+                if flat.is_empty() {
+                    break;
+                }
+                flips += 1;
+                if flips <= MAX_UNBLOCK && self.dt.flip_away(&flat) {
+                    continue;
+                }
+                return Err("a flat tet lies in a surface triangle");
             };
             let (pu, pv) = (self.dt.p(u), self.dt.p(v));
             let p = segment_plane(pu, pv, fp);
+            let next = self.dt.next_id();
+            self.dt.on_face.insert(next, sorted3(f));
             let s = match self.dt.split_edge(u, v, p) {
                 Ok(s) => s,
                 Err(bad) => {
+                    self.dt.on_face.remove(&next);
                     flips += 1;
                     if flips <= MAX_UNBLOCK && self.dt.flip_away(&bad) {
                         continue;
@@ -318,15 +348,15 @@ impl<'a> Cdt<'a> {
                 }
             }
         }
-        for t in 0..nt {
-            if !self.dt.alive[t] || state[t] != 2 {
+        for (t, &st) in state.iter().enumerate() {
+            if !self.dt.alive[t] || st != 2 {
                 continue;
             }
             let tv = self.dt.tets[t];
             if tv.iter().any(|v| far.contains(v)) {
                 return Err("the surface does not enclose the region");
             }
-            for (k, fk) in FACES.iter().enumerate() {
+            for fk in FACES {
                 let g = fk.map(|j| tv[j]);
                 if self.parent.contains_key(&sorted3(g)) {
                     // The region must be on the face's positive side: its outward face
@@ -342,9 +372,9 @@ impl<'a> Cdt<'a> {
                 }
             }
         }
-        for t in 0..nt {
-            if self.dt.alive[t] && state[t] != 2 {
-                self.dt.alive[t] = false;
+        for (alive, &st) in self.dt.alive.iter_mut().zip(&state) {
+            if st != 2 {
+                *alive = false;
             }
         }
         for t in 0..nt {
@@ -398,8 +428,30 @@ impl<'a> Cdt<'a> {
                     break;
                 }
                 let comp = self.component(s, &star);
+                let mut groups = 0;
+                for attempt in 0..=MAX_UNBLOCK {
+                    let comp = if attempt == 0 {
+                        comp.clone()
+                    } else {
+                        let star = self.dt.star(s);
+                        if star.is_empty() {
+                            break;
+                        }
+                        self.component(s, &star)
+                    };
+                    match self.move_off(s, &comp, attempt < MAX_UNBLOCK)? {
+                        0 => continue,
+                        usize::MAX => {
+                            groups = self.move_off(s, &comp, false)?;
+                            break;
+                        }
+                        g => {
+                            groups = g;
+                            break;
+                        }
+                    }
+                }
                 seen.extend(comp.iter().copied());
-                let groups = self.move_off(s, &comp)?;
                 left = left.saturating_sub(groups);
             }
         }
@@ -415,9 +467,9 @@ impl<'a> Cdt<'a> {
             let t = out[k];
             k += 1;
             let tv = self.dt.tets[t as usize];
-            for j in 0..4 {
+            for (j, &v) in tv.iter().enumerate() {
                 let nb = self.dt.adj[t as usize][j];
-                if tv[j] != s && nb != NONE && set.contains(&nb) && !out.contains(&nb) {
+                if v != s && nb != NONE && set.contains(&nb) && !out.contains(&nb) {
                     out.push(nb);
                 }
             }
@@ -427,7 +479,9 @@ impl<'a> Cdt<'a> {
 
     /// Move Steiner point `s` off the surface within the tets `comp` around it. Returns
     /// how many surface triangles it was on there.
-    fn move_off(&mut self, s: u32, comp: &[u32]) -> Result<usize, &'static str> {
+    /// With `unblock`, a point that cannot be placed makes it flip the link tets in the
+    /// way instead and return 0 (or usize::MAX when no flip applies).
+    fn move_off(&mut self, s: u32, comp: &[u32], unblock: bool) -> Result<usize, &'static str> {
         // The constraint faces at s, outward, grouped by input face: edges x -> y of
         // the faces (s, x, y).
         let mut groups: HashMap<usize, Vec<[u32; 2]>> = HashMap::new();
@@ -466,9 +520,11 @@ impl<'a> Cdt<'a> {
             let poly = polygon(edges).ok_or("the faces at a Steiner point are no fan")?;
             let (proj, sign) = projection_of(f[0], f[1], f[2]).ok_or("degenerate triangle")?;
             // Outward faces turn the other way from the input face.
-            let tris = ear_clip(&poly, |a, b, c| {
-                proj.orient2d(self.dt.p(a), self.dt.p(b), self.dt.p(c)) == -sign
-            })
+            let tris = ear_clip(
+                &poly,
+                |a, b, c| proj.orient2d(self.dt.p(a), self.dt.p(b), self.dt.p(c)) == -sign,
+                |a, b, c| tri_shape(self.dt.p(a), self.dt.p(b), self.dt.p(c)),
+            )
             .ok_or("the faces at a Steiner point cannot be retriangulated")?;
             new_faces.extend(tris.into_iter().map(|t| (t, i)));
         }
@@ -496,10 +552,37 @@ impl<'a> Cdt<'a> {
             .map(|tv| tv.map(|v| if v == s { q } else { v }))
             .collect();
         tets.extend(new_faces.iter().map(|(g, _)| [g[0], g[2], g[1], q]));
+        // Candidate directions: the inward normal, toward the star's centre, toward each
+        // link tet's centroid.
+        let mut dirs = vec![inward, centre];
+        for tv in &link {
+            let c = tv
+                .iter()
+                .filter(|&&v| v != s)
+                .fold([0.0; 3], |a, &v| axpy(a, 1.0 / 3.0, self.dt.p(v)));
+            dirs.push(sub(c, ps));
+        }
+        // Best: the centre of the largest ball in the new star's kernel (each new tet
+        // positive is one half-space for the point); else small steps along `dirs`.
+        let walls: Vec<[P3; 3]> = tets
+            .iter()
+            .map(|tv| {
+                let j = tv.iter().position(|&v| v == q).unwrap_or(3);
+                let f = FACES[j];
+                [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
+            })
+            .collect();
         let mut placed = false;
-        'dirs: for d in [inward, centre] {
+        if let Some(c) = kernel_centre(&walls, ps) {
+            self.dt.pts[q as usize] = c;
+            placed = tets.iter().all(|&t| self.dt.positive(t));
+        }
+        'dirs: for d in dirs {
+            if placed {
+                break;
+            }
             let l = norm(d);
-            if !(l > 0.0) || !reach.is_finite() {
+            if l.is_nan() || l <= 0.0 || !reach.is_finite() {
                 continue;
             }
             for k in 1..60 {
@@ -511,11 +594,34 @@ impl<'a> Cdt<'a> {
                 }
             }
         }
+        if !placed && unblock {
+            // Flip the link tets the inward step inverts, and try again.
+            let l = norm(inward);
+            if l > 0.0 && reach.is_finite() {
+                self.dt.pts[q as usize] = axpy(ps, reach * 1e-6 / l, inward);
+            }
+            let bad: Vec<u32> = comp
+                .iter()
+                .zip(&tets)
+                .filter(|(_, &t)| !self.dt.positive(t))
+                .map(|(&t, _)| t)
+                .collect();
+            self.dt.pop_point();
+            return Ok(if self.dt.flip_away(&bad) {
+                0
+            } else {
+                usize::MAX
+            });
+        }
         if !placed {
             return Err("no interior point sees a Steiner point's star");
         }
         self.dt.replace(comp, &tets);
         for (g, i) in new_faces {
+            for k in 0..3 {
+                self.dt.fixed_edges.insert(sorted2(g[k], g[(k + 1) % 3]));
+            }
+            self.dt.fixed_faces.insert(sorted3(g));
             self.parent.insert(sorted3(g), i);
         }
         Ok(groups.len())
@@ -609,19 +715,31 @@ fn polygon(edges: &[[u32; 2]]) -> Option<Vec<u32>> {
 }
 
 /// Ear clipping of a simple polygon; `ccw(a, b, c)` is the exact test that a triangle
-/// turns the polygon's way. An ear contains no other polygon vertex (closed test).
-fn ear_clip(poly: &[u32], ccw: impl Fn(u32, u32, u32) -> bool) -> Option<Vec<[u32; 3]>> {
+/// turns the polygon's way, `shape` a (rounded) quality of a triangle: of the valid ears
+/// (turning the right way, no other polygon vertex in the closed triangle) the best shaped
+/// is cut first, so that runs of nearly collinear points (split edges) are joined across
+/// the polygon rather than to each other.
+fn ear_clip(
+    poly: &[u32],
+    ccw: impl Fn(u32, u32, u32) -> bool,
+    shape: impl Fn(u32, u32, u32) -> f64,
+) -> Option<Vec<[u32; 3]>> {
     let mut p = poly.to_vec();
     let mut out = Vec::new();
     while p.len() > 3 {
         let m = p.len();
-        let ear = (0..m).find(|&i| {
-            let (a, b, c) = (p[(i + m - 1) % m], p[i], p[(i + 1) % m]);
-            ccw(a, b, c)
-                && p.iter().all(|&x| {
-                    [a, b, c].contains(&x) || !(!ccw(b, a, x) && !ccw(c, b, x) && !ccw(a, c, x))
-                })
-        })?;
+        let ear = (0..m)
+            .filter(|&i| {
+                let (a, b, c) = (p[(i + m - 1) % m], p[i], p[(i + 1) % m]);
+                ccw(a, b, c)
+                    && p.iter().all(|&x| {
+                        [a, b, c].contains(&x) || !(!ccw(b, a, x) && !ccw(c, b, x) && !ccw(a, c, x))
+                    })
+            })
+            .max_by(|&i, &j| {
+                let q = |i: usize| shape(p[(i + m - 1) % m], p[i], p[(i + 1) % m]);
+                q(i).total_cmp(&q(j))
+            })?;
         let (a, b, c) = (p[(ear + m - 1) % m], p[ear], p[(ear + 1) % m]);
         out.push([a, b, c]);
         p.remove(ear);
@@ -633,6 +751,50 @@ fn ear_clip(poly: &[u32], ccw: impl Fn(u32, u32, u32) -> bool) -> Option<Vec<[u3
         out.push([p[0], p[1], p[2]]);
     }
     Some(out)
+}
+
+/// A point strictly on the positive side of every triangle: the centre of the largest
+/// ball in their half-spaces' intersection (a linear program, coordinates relative to
+/// `o`), checked exactly.
+fn kernel_centre(walls: &[[P3; 3]], o: P3) -> Option<P3> {
+    use microlp::{ComparisonOp, OptimizationDirection, Problem};
+    let mut pr = Problem::new(OptimizationDirection::Maximize);
+    let inf = f64::INFINITY;
+    let x = pr.add_var(0.0, (-inf, inf));
+    let y = pr.add_var(0.0, (-inf, inf));
+    let z = pr.add_var(0.0, (-inf, inf));
+    let t = pr.add_var(1.0, (0.0, inf));
+    for w in walls {
+        let p = w.map(|v| sub(v, o));
+        let n = tri_normal(p[0], p[1], p[2]);
+        let l = norm(n);
+        if l.is_nan() || l <= 0.0 {
+            return None;
+        }
+        let n = [n[0] / l, n[1] / l, n[2] / l];
+        // n . (q - p0) >= t
+        pr.add_constraint(
+            [(x, n[0]), (y, n[1]), (z, n[2]), (t, -1.0)],
+            ComparisonOp::Ge,
+            dot(n, p[0]),
+        );
+    }
+    let sol = pr.solve().ok()?.into_solution().ok()?;
+    if sol.var_value(t).is_nan() || sol.var_value(t) <= 0.0 {
+        return None;
+    }
+    let q = [sol.var_value(x), sol.var_value(y), sol.var_value(z)];
+    let q = [q[0] + o[0], q[1] + o[1], q[2] + o[2]];
+    walls
+        .iter()
+        .all(|w| orient3d(w[0], w[1], w[2], q) > 0)
+        .then_some(q)
+}
+
+/// Area over the sum of squared edge lengths (0 for a degenerate triangle).
+fn tri_shape(a: P3, b: P3, c: P3) -> f64 {
+    let l = super::vec3::dist2(a, b) + super::vec3::dist2(b, c) + super::vec3::dist2(c, a);
+    norm(tri_normal(a, b, c)) / l.max(f64::MIN_POSITIVE)
 }
 
 /// Where segment ab meets the plane of `f` (rounded).
@@ -775,38 +937,14 @@ mod tests {
         assert!(r.pts.len() > 6, "{} points", r.pts.len());
     }
 
+    /// Whole CAD parts (OpenSCAD exports) filled from their vertices alone: the
+    /// hardest use of the fill (coplanar faces, cospherical points everywhere).
     #[test]
-    fn proto_one() {
-        let Ok(f) = std::env::var("FILL_ONE") else {
-            return;
-        };
-        let s = crate::io::read_any_surface(std::path::Path::new(&f), &Default::default()).unwrap();
-        let corners = s.corner_nodes();
-        let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
-        let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
-        let faces: Vec<[u32; 3]> = s
-            .triangles()
-            .iter()
-            .map(|t| [local(t[0]), local(t[1]), local(t[2])])
-            .collect();
-        eprintln!("{:?}", fill_and_check(&pts, &faces).map(|r| r.tets.len()));
-    }
-
-    #[test]
-    fn proto_corpus() {
-        let dir = std::path::Path::new("/work/shared/data/openscad");
-        let Ok(rd) = std::fs::read_dir(dir) else {
-            return;
-        };
-        let mut names: Vec<_> = rd
-            .filter_map(|e| e.ok())
-            .map(|e| e.path())
-            .filter(|p| p.extension().is_some_and(|x| x == "stl"))
-            .collect();
-        names.sort();
-        let mut ok = 0;
-        for p in &names {
-            let s = crate::io::read_any_surface(p, &Default::default()).unwrap();
+    fn openscad_parts_fill_with_their_boundary_kept() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad");
+        for name in ["LetterBlock", "example002", "example013", "example014"] {
+            let path = dir.join(format!("{name}.stl"));
+            let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
             let corners = s.corner_nodes();
             let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
             let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
@@ -815,24 +953,8 @@ mod tests {
                 .iter()
                 .map(|t| [local(t[0]), local(t[1]), local(t[2])])
                 .collect();
-            let t0 = std::time::Instant::now();
-            let r = fill_and_check(&pts, &faces);
-            eprintln!(
-                "{:<36} {:>6} tris {:>8.3}s {}",
-                p.file_name().unwrap().to_string_lossy(),
-                faces.len(),
-                t0.elapsed().as_secs_f64(),
-                match &r {
-                    Ok(f) => format!(
-                        "ok {} tets {} new pts",
-                        f.tets.len(),
-                        f.pts.len() - pts.len()
-                    ),
-                    Err(e) => format!("FAIL {e}"),
-                }
-            );
-            ok += r.is_ok() as usize;
+            let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(r.tets.len() >= faces.len() / 4, "{name}");
         }
-        eprintln!("filled {ok} of {}", names.len());
     }
 }

@@ -56,6 +56,12 @@ pub(crate) struct Delaunay {
     /// A live tet containing each point (kept by every change; [`NONE`] before the point
     /// is in a tet).
     vt: Vec<u32>,
+    /// Points added on an input edge: the edge (sorted ids).
+    pub on_line: HashMap<u32, [u32; 2]>,
+    /// Points added inside an input face: the face (sorted ids).
+    pub on_face: HashMap<u32, [u32; 3]>,
+    /// Input edge (sorted) -> the input faces (sorted) using it.
+    pub edge_faces: HashMap<[u32; 2], Vec<[u32; 3]>>,
     /// Edges (sorted ids) that no flip may remove: recovered constraint edges.
     pub fixed_edges: HashSet<[u32; 2]>,
     /// Faces (sorted ids) that no flip may remove: recovered constraint faces.
@@ -114,6 +120,9 @@ impl Delaunay {
             adj: vec![[NONE; 4]],
             alive: vec![true],
             vt,
+            on_line: HashMap::new(),
+            on_face: HashMap::new(),
+            edge_faces: HashMap::new(),
             fixed_edges: HashSet::new(),
             fixed_faces: HashSet::new(),
             last: 0,
@@ -251,215 +260,13 @@ impl Delaunay {
     }
 
     /// Live tets whose four vertices are all input points.
+    #[cfg(test)]
     pub(crate) fn interior_tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
         let n = self.n as u32;
         (0..self.tets.len())
             .filter(move |&t| self.alive[t] && self.tets[t].iter().all(|&v| v < n))
             .map(move |t| self.tets[t])
     }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn rng(seed: &mut u64) -> f64 {
-        *seed ^= *seed << 13;
-        *seed ^= *seed >> 7;
-        *seed ^= *seed << 17;
-        (*seed >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    fn check_delaunay(dt: &Delaunay) {
-        let live: Vec<usize> = (0..dt.tets.len()).filter(|&t| dt.alive[t]).collect();
-        for &t in &live {
-            let v = dt.tets[t];
-            let p = v.map(|x| dt.pts[x as usize]);
-            assert!(orient3d(p[0], p[1], p[2], p[3]) > 0, "tet {t} not positive");
-            // Empty circumsphere against every point.
-            for (i, &q) in dt.pts.iter().enumerate() {
-                if v.contains(&(i as u32)) {
-                    continue;
-                }
-                assert!(
-                    insphere(p[0], p[1], p[2], p[3], q) <= 0,
-                    "point {i} in tet {t}'s sphere"
-                );
-            }
-            // Links are mutual and across the same face.
-            for k in 0..4 {
-                let nb = dt.adj[t][k];
-                if nb == NONE {
-                    continue;
-                }
-                assert!(dt.alive[nb as usize]);
-                let mut f: Vec<u32> = FACES[k].iter().map(|&j| v[j]).collect();
-                f.sort_unstable();
-                let w = dt.tets[nb as usize];
-                assert!(f.iter().all(|x| w.contains(x)));
-                assert!(dt.adj[nb as usize].contains(&(t as u32)));
-            }
-        }
-        // The tets fill the enclosing tet: volumes add up.
-        let vol = |v: [u32; 4]| {
-            let p = v.map(|x| dt.pts[x as usize]);
-            crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3])
-        };
-        let total: f64 = live.iter().map(|&t| vol(dt.tets[t])).sum();
-        let n = dt.n as u32;
-        let outer = vol([n, n + 1, n + 2, n + 3]).abs();
-        assert!((total - outer).abs() <= 1e-9 * outer, "{total} vs {outer}");
-    }
-
-    #[test]
-    fn insphere_sign_matches_our_orientation() {
-        let a = [0.0, 0.0, 0.0];
-        let b = [1.0, 0.0, 0.0];
-        let c = [0.0, 1.0, 0.0];
-        let d = [0.0, 0.0, 1.0];
-        assert!(orient3d(a, b, c, d) > 0);
-        assert_eq!(insphere(a, b, c, d, [0.2, 0.2, 0.2]), 1);
-        assert_eq!(insphere(a, b, c, d, [5.0, 5.0, 5.0]), -1);
-        assert_eq!(insphere(a, b, c, d, [1.0, 1.0, 0.0]), 0);
-    }
-
-    #[test]
-    fn random_points_give_an_empty_sphere_triangulation() {
-        let mut s = 0x9e3779b97f4a7c15u64;
-        let pts: Vec<P3> = (0..200)
-            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
-            .collect();
-        let dt = Delaunay::new(&pts);
-        check_delaunay(&dt);
-        assert!(dt.interior_tets().count() > 200);
-    }
-
-    #[test]
-    fn grid_points_cospherical_and_duplicates() {
-        // A 4 x 4 x 4 lattice: every cube's 8 corners are cospherical.
-        let mut pts = Vec::new();
-        for i in 0..4 {
-            for j in 0..4 {
-                for k in 0..4 {
-                    pts.push([i as f64, j as f64, k as f64]);
-                }
-            }
-        }
-        pts.push([1.0, 1.0, 1.0]);
-        let dt = Delaunay::new(&pts);
-        check_delaunay(&dt);
-        // The lattice's 27 cubes, each of volume 1, are covered.
-        let vol: f64 = dt
-            .interior_tets()
-            .map(|v| {
-                let p = v.map(|x| dt.pts[x as usize]);
-                crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3]) / 6.0
-            })
-            .sum();
-        assert!((vol - 27.0).abs() < 1e-9, "{vol}");
-        assert!(dt.interior_tets().all(|t| !t.contains(&64)));
-    }
-}
-
-/// A constraint face or edge a tetrahedralization lacks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Missing {
-    /// An edge of a constraint face (local point ids).
-    Edge([u32; 2]),
-    /// Constraint face `i` (its edges are all there).
-    Face(usize),
-}
-
-impl Delaunay {
-    /// The first edge, then the first face, of `faces` (local point ids) that is not in
-    /// the triangulation.
-    pub(crate) fn first_missing(&self, faces: &[[u32; 3]]) -> Option<Missing> {
-        let mut edges = std::collections::HashSet::new();
-        let mut tris = std::collections::HashSet::new();
-        for (t, v) in self.tets.iter().enumerate() {
-            if !self.alive[t] {
-                continue;
-            }
-            for i in 0..4 {
-                for j in i + 1..4 {
-                    edges.insert(sorted2(v[i], v[j]));
-                }
-                tris.insert(sorted3(FACES[i].map(|k| v[k])));
-            }
-        }
-        for f in faces {
-            for k in 0..3 {
-                let e = sorted2(f[k], f[(k + 1) % 3]);
-                if !edges.contains(&e) {
-                    return Some(Missing::Edge(e));
-                }
-            }
-        }
-        faces
-            .iter()
-            .position(|f| !tris.contains(&sorted3(*f)))
-            .map(Missing::Face)
-    }
-
-    /// The tets enclosed by `faces` (local ids; every face in the triangulation, oriented
-    /// with its normal into the enclosed region): those reached from the faces' inner
-    /// sides without crossing a face. None if an enclosing point is reached (the faces do
-    /// not enclose).
-    pub(crate) fn enclosed(&self, faces: &[[u32; 3]]) -> Option<Vec<[u32; 4]>> {
-        let walls: std::collections::HashSet<[u32; 3]> =
-            faces.iter().map(|f| sorted3(*f)).collect();
-        let mut by_face: HashMap<[u32; 3], (u32, usize)> = HashMap::new();
-        for (t, v) in self.tets.iter().enumerate() {
-            if self.alive[t] {
-                for (k, f) in FACES.iter().enumerate() {
-                    // Keyed by the face as seen from inside tet t (outward order reversed).
-                    by_face.insert([v[f[0]], v[f[2]], v[f[1]]], (t as u32, k));
-                }
-            }
-        }
-        let mut inside = vec![false; self.tets.len()];
-        let mut stack = Vec::new();
-        for f in faces {
-            // The tet on f's inner side sees f with f's own orientation reversed... the
-            // tet t whose outward face is (f0, f2, f1) has f's normal pointing into t.
-            let key = rotations(*f);
-            let hit = key.iter().find_map(|k| by_face.get(k));
-            let (t, _) = *hit?;
-            if !inside[t as usize] {
-                inside[t as usize] = true;
-                stack.push(t);
-            }
-        }
-        while let Some(t) = stack.pop() {
-            let v = self.tets[t as usize];
-            if v.iter().any(|&x| x as usize >= self.n) {
-                return None;
-            }
-            for (k, f) in FACES.iter().enumerate() {
-                if walls.contains(&sorted3(f.map(|j| v[j]))) {
-                    continue;
-                }
-                let nb = self.adj[t as usize][k];
-                if nb == NONE {
-                    return None;
-                }
-                if !inside[nb as usize] {
-                    inside[nb as usize] = true;
-                    stack.push(nb);
-                }
-            }
-        }
-        Some(
-            (0..self.tets.len())
-                .filter(|&t| inside[t])
-                .map(|t| self.tets[t])
-                .collect(),
-        )
-    }
-}
-
-fn rotations(f: [u32; 3]) -> [[u32; 3]; 3] {
-    [f, [f[1], f[2], f[0]], [f[2], f[0], f[1]]]
 }
 
 pub(crate) fn sorted2(a: u32, b: u32) -> [u32; 2] {
@@ -534,6 +341,45 @@ impl Delaunay {
         ids
     }
 
+    /// A tet a change may create: positive, and not flat by construction: its points
+    /// (an added point standing for the input edge or face it was put on) all on one
+    /// plane of input points, exactly, so that only rounding makes it positive.
+    pub(crate) fn valid_new(&self, t: [u32; 4]) -> bool {
+        self.positive(t) && !self.flat_by_construction(t)
+    }
+
+    fn flat_by_construction(&self, t: [u32; 4]) -> bool {
+        let mut sup: Vec<u32> = Vec::with_capacity(12);
+        let mut added = false;
+        for &v in &t {
+            if let Some(e) = self.on_line.get(&v) {
+                sup.extend_from_slice(e);
+                added = true;
+            } else if let Some(f) = self.on_face.get(&v) {
+                sup.extend_from_slice(f);
+                added = true;
+            } else {
+                sup.push(v);
+            }
+        }
+        if !added {
+            return false;
+        }
+        sup.sort_unstable();
+        sup.dedup();
+        let p: Vec<P3> = sup.iter().map(|&v| self.p(v)).collect();
+        // Three points not on a line, then every other point on their plane.
+        let base = (1..p.len()).find_map(|i| {
+            (i + 1..p.len())
+                .find(|&j| !super::predicates::collinear(p[0], p[i], p[j]))
+                .map(|j| (i, j))
+        });
+        let Some((i, j)) = base else {
+            return true; // all on one line
+        };
+        p.iter().all(|&x| orient3d(p[0], p[i], p[j], x) == 0)
+    }
+
     pub(crate) fn positive(&self, t: [u32; 4]) -> bool {
         orient3d(self.p(t[0]), self.p(t[1]), self.p(t[2]), self.p(t[3])) > 0
     }
@@ -557,7 +403,7 @@ impl Delaunay {
         };
         // New tets (p, q, a, b)... each (edge of f, a, b) with positive orientation.
         let new = [[f[0], f[1], a, b], [f[1], f[2], a, b], [f[2], f[0], a, b]];
-        if !new.iter().all(|&n| self.positive(n)) {
+        if !new.iter().all(|&n| self.valid_new(n)) {
             return false;
         }
         self.replace(&[t, u], &new);
@@ -590,7 +436,7 @@ impl Delaunay {
         if !self.positive(t2) {
             t2.swap(0, 1);
         }
-        if !self.positive(t1) || !self.positive(t2) {
+        if !self.valid_new(t1) || !self.valid_new(t2) {
             return false;
         }
         // a and b on opposite sides of (p, q, r) (else the two tets overlap).
@@ -661,7 +507,7 @@ impl Delaunay {
                     new.push(t);
                 }
             }
-            if new.iter().all(|&t| self.positive(t))
+            if new.iter().all(|&t| self.valid_new(t))
                 && (1..n - 1).all(|k| {
                     // x and y on opposite sides of each fan triangle.
                     let a = self.p(ring[apex]);
@@ -703,8 +549,8 @@ impl Delaunay {
             let t = out[k];
             k += 1;
             let tv = self.tets[t as usize];
-            for j in 0..4 {
-                if tv[j] == v {
+            for (j, &w) in tv.iter().enumerate() {
+                if w == v {
                     continue;
                 }
                 let nb = self.adj[t as usize][j];
@@ -726,6 +572,17 @@ impl Delaunay {
                 }
             }
         }
+    }
+
+    /// Drop the last added point (in no tet).
+    pub(crate) fn pop_point(&mut self) {
+        self.pts.pop();
+        self.vt.pop();
+    }
+
+    /// The id the next added point gets.
+    pub(crate) fn next_id(&self) -> u32 {
+        self.pts.len() as u32
     }
 
     /// A new point (not yet in any tet).
@@ -762,7 +619,7 @@ impl Delaunay {
             let tv = self.tets[t as usize];
             for &x in w {
                 let nt = tv.map(|v| if v == x { s } else { v });
-                if self.positive(nt) {
+                if self.valid_new(nt) {
                     new.push(nt);
                 } else if !bad.contains(&t) {
                     bad.push(t);
@@ -943,5 +800,107 @@ impl Delaunay {
             }
         }
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rng(seed: &mut u64) -> f64 {
+        *seed ^= *seed << 13;
+        *seed ^= *seed >> 7;
+        *seed ^= *seed << 17;
+        (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    fn check_delaunay(dt: &Delaunay) {
+        let live: Vec<usize> = (0..dt.tets.len()).filter(|&t| dt.alive[t]).collect();
+        for &t in &live {
+            let v = dt.tets[t];
+            let p = v.map(|x| dt.pts[x as usize]);
+            assert!(orient3d(p[0], p[1], p[2], p[3]) > 0, "tet {t} not positive");
+            // Empty circumsphere against every point.
+            for (i, &q) in dt.pts.iter().enumerate() {
+                if v.contains(&(i as u32)) {
+                    continue;
+                }
+                assert!(
+                    insphere(p[0], p[1], p[2], p[3], q) <= 0,
+                    "point {i} in tet {t}'s sphere"
+                );
+            }
+            // Links are mutual and across the same face.
+            for (k, fk) in FACES.iter().enumerate() {
+                let nb = dt.adj[t][k];
+                if nb == NONE {
+                    continue;
+                }
+                assert!(dt.alive[nb as usize]);
+                let mut f: Vec<u32> = fk.iter().map(|&j| v[j]).collect();
+                f.sort_unstable();
+                let w = dt.tets[nb as usize];
+                assert!(f.iter().all(|x| w.contains(x)));
+                assert!(dt.adj[nb as usize].contains(&(t as u32)));
+            }
+        }
+        // The tets fill the enclosing tet: volumes add up.
+        let vol = |v: [u32; 4]| {
+            let p = v.map(|x| dt.pts[x as usize]);
+            crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3])
+        };
+        let total: f64 = live.iter().map(|&t| vol(dt.tets[t])).sum();
+        let n = dt.n as u32;
+        let outer = vol([n, n + 1, n + 2, n + 3]).abs();
+        assert!((total - outer).abs() <= 1e-9 * outer, "{total} vs {outer}");
+    }
+
+    #[test]
+    fn insphere_sign_matches_our_orientation() {
+        let a = [0.0, 0.0, 0.0];
+        let b = [1.0, 0.0, 0.0];
+        let c = [0.0, 1.0, 0.0];
+        let d = [0.0, 0.0, 1.0];
+        assert!(orient3d(a, b, c, d) > 0);
+        assert_eq!(insphere(a, b, c, d, [0.2, 0.2, 0.2]), 1);
+        assert_eq!(insphere(a, b, c, d, [5.0, 5.0, 5.0]), -1);
+        assert_eq!(insphere(a, b, c, d, [1.0, 1.0, 0.0]), 0);
+    }
+
+    #[test]
+    fn random_points_give_an_empty_sphere_triangulation() {
+        let mut s = 0x9e3779b97f4a7c15u64;
+        let pts: Vec<P3> = (0..200)
+            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
+            .collect();
+        let dt = Delaunay::new(&pts);
+        check_delaunay(&dt);
+        assert!(dt.interior_tets().count() > 200);
+    }
+
+    #[test]
+    fn grid_points_cospherical_and_duplicates() {
+        // A 4 x 4 x 4 lattice: every cube's 8 corners are cospherical.
+        let mut pts = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                for k in 0..4 {
+                    pts.push([i as f64, j as f64, k as f64]);
+                }
+            }
+        }
+        pts.push([1.0, 1.0, 1.0]);
+        let dt = Delaunay::new(&pts);
+        check_delaunay(&dt);
+        // The lattice's 27 cubes, each of volume 1, are covered.
+        let vol: f64 = dt
+            .interior_tets()
+            .map(|v| {
+                let p = v.map(|x| dt.pts[x as usize]);
+                crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3]) / 6.0
+            })
+            .sum();
+        assert!((vol - 27.0).abs() < 1e-9, "{vol}");
+        assert!(dt.interior_tets().all(|t| !t.contains(&64)));
     }
 }
