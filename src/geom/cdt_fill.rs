@@ -22,7 +22,7 @@
 use super::delaunay::{sorted2, sorted3, Delaunay, FACES, NONE};
 use super::predicates::{orient3d, projection_of};
 use super::vec3::{axpy, dist, dot, norm, sub, tet_det, tri_normal, P3};
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 /// A filled region: the input points then the new interior points, and positive tets.
 pub(crate) struct Filled {
@@ -484,7 +484,7 @@ impl<'a> Cdt<'a> {
     fn move_off(&mut self, s: u32, comp: &[u32], unblock: bool) -> Result<usize, &'static str> {
         // The constraint faces at s, outward, grouped by input face: edges x -> y of
         // the faces (s, x, y).
-        let mut groups: HashMap<usize, Vec<[u32; 2]>> = HashMap::new();
+        let mut groups: BTreeMap<usize, Vec<[u32; 2]>> = BTreeMap::new();
         let mut link: Vec<[u32; 4]> = Vec::new();
         for &t in comp {
             let tv = self.dt.tets[t as usize];
