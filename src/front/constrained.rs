@@ -53,7 +53,9 @@ impl Mesher<'_> {
             if validity::check(*t, tp, fixed, pos, 0.0).is_err() {
                 return false;
             }
-            if !self.opts.optimize
+            // Curved tets the fill makes next to a curved face are left to the optimizer
+            // except on the last attempt (a restart follows one it cannot untangle).
+            if !(self.opts.optimize && self.fill_p2_invalid)
                 && self
                     .p2_nodes(*t, &tp)
                     .is_some_and(|x| !super::curved_valid(&x))

@@ -296,6 +296,8 @@ pub(crate) struct Mesher<'a> {
     max_repairs_without_progress: u64,
     /// Close stuck cavities by the constrained fill (off only in tests of the repair path).
     use_fill: bool,
+    /// May the fill make curved tets with a non-positive Jacobian (for the optimizer)?
+    fill_p2_invalid: bool,
     /// The stage name progress is reported under ([`attempt_stage`]).
     stage: String,
     // scratch
@@ -363,6 +365,7 @@ impl<'a> Mesher<'a> {
             fewest_open: (usize::MAX, 0),
             max_repairs_without_progress: repairs_without_progress_limit(0),
             use_fill: fill_enabled(),
+            fill_p2_invalid: true,
             stage: attempt_stage(0),
             repair_cell: 2.0 * mean_edge,
             near_ids: Vec::new(),
@@ -1161,6 +1164,7 @@ pub fn run_front(
         m.stats.size_scale = fs;
         m.stage = attempt_stage(attempt);
         m.max_repairs_without_progress = repairs_without_progress_limit(attempt);
+        m.fill_p2_invalid = attempt + 1 < RESTARTS.len();
         match m.run(progress) {
             Ok(()) => {
                 // The live tets and their qualities.

@@ -11,8 +11,8 @@
 //!    a union of mesh faces.
 //! 4. The enclosed tets by parity across the constraint faces; the rest are dropped.
 //! 5. Every Steiner point is then moved off the surface (TetGen's `-Y`): its star's
-//!    constraint faces are retriangulated without it (ear clipping in the triangle's
-//!    plane, exact 2D orientations) and it is placed along the inward normal where every
+//!    constraint faces are retriangulated without it (a best-shaped triangulation in
+//!    the triangle's plane, exact 2D orientations) and it is placed along the inward normal where every
 //!    tet of its new star is positive. The surface triangles come back exactly.
 //!
 //! Every topological decision is an exact orient3d/orient2d; the Steiner coordinates are
@@ -520,9 +520,12 @@ impl<'a> Cdt<'a> {
             let poly = polygon(edges).ok_or("the faces at a Steiner point are no fan")?;
             let (proj, sign) = projection_of(f[0], f[1], f[2]).ok_or("degenerate triangle")?;
             // Outward faces turn the other way from the input face.
-            let tris = ear_clip(
+            let tris = triangulate_polygon(
                 &poly,
-                |a, b, c| proj.orient2d(self.dt.p(a), self.dt.p(b), self.dt.p(c)) == -sign,
+                |a, b, c| {
+                    !self.dt.collinear_by_construction([a, b, c])
+                        && proj.orient2d(self.dt.p(a), self.dt.p(b), self.dt.p(c)) == -sign
+                },
                 |a, b, c| tri_shape(self.dt.p(a), self.dt.p(b), self.dt.p(c)),
             )
             .ok_or("the faces at a Steiner point cannot be retriangulated")?;
@@ -671,6 +674,23 @@ impl<'a> Cdt<'a> {
         if bound != want {
             return Err("the filled region's boundary is not the surface");
         }
+        // Overlapping tets would show as more volume than the surface encloses.
+        let vol = |t: &[u32; 4]| {
+            let p = t.map(|v| pts[v as usize]);
+            tet_det(p[0], p[1], p[2], p[3]).abs()
+        };
+        let filled: f64 = tets.iter().map(vol).sum();
+        let enclosed: f64 = self
+            .faces
+            .iter()
+            .map(|f| {
+                let p = f.map(|v| pts[v as usize]);
+                -super::vec3::det3(p[0], p[1], p[2])
+            })
+            .sum();
+        if (filled - enclosed).abs() > 1e-9 * filled.max(enclosed.abs()) {
+            return Err("the filled tets overlap");
+        }
         Ok(Filled { pts, tets })
     }
 
@@ -714,41 +734,66 @@ fn polygon(edges: &[[u32; 2]]) -> Option<Vec<u32>> {
     (poly.len() == edges.len() + usize::from(!closed)).then_some(poly)
 }
 
-/// Ear clipping of a simple polygon; `ccw(a, b, c)` is the exact test that a triangle
-/// turns the polygon's way, `shape` a (rounded) quality of a triangle: of the valid ears
-/// (turning the right way, no other polygon vertex in the closed triangle) the best shaped
-/// is cut first, so that runs of nearly collinear points (split edges) are joined across
-/// the polygon rather than to each other.
-fn ear_clip(
+/// Triangulate a simple polygon (vertices in order, closed from the last to the first)
+/// maximising the worst triangle's `shape`, by dynamic programming over its diagonals.
+/// `ccw(a, b, c)` is the exact test that a triangle turns the polygon's way; a triangle
+/// is allowed when it does and no other polygon vertex is in it (closed). The best worst
+/// shape avoids joining runs of nearly collinear points (split edges) to each other.
+fn triangulate_polygon(
     poly: &[u32],
     ccw: impl Fn(u32, u32, u32) -> bool,
     shape: impl Fn(u32, u32, u32) -> f64,
 ) -> Option<Vec<[u32; 3]>> {
-    let mut p = poly.to_vec();
-    let mut out = Vec::new();
-    while p.len() > 3 {
-        let m = p.len();
-        let ear = (0..m)
-            .filter(|&i| {
-                let (a, b, c) = (p[(i + m - 1) % m], p[i], p[(i + 1) % m]);
-                ccw(a, b, c)
-                    && p.iter().all(|&x| {
-                        [a, b, c].contains(&x) || !(!ccw(b, a, x) && !ccw(c, b, x) && !ccw(a, c, x))
-                    })
-            })
-            .max_by(|&i, &j| {
-                let q = |i: usize| shape(p[(i + m - 1) % m], p[i], p[(i + 1) % m]);
-                q(i).total_cmp(&q(j))
-            })?;
-        let (a, b, c) = (p[(ear + m - 1) % m], p[ear], p[(ear + 1) % m]);
-        out.push([a, b, c]);
-        p.remove(ear);
+    let n = poly.len();
+    if n < 3 {
+        return None;
     }
-    if p.len() == 3 {
-        if !ccw(p[0], p[1], p[2]) {
-            return None;
+    let ok = |i: usize, k: usize, j: usize| {
+        let (a, b, c) = (poly[i], poly[k], poly[j]);
+        ccw(a, b, c)
+            && poly
+                .iter()
+                .all(|&x| [a, b, c].contains(&x) || ccw(b, a, x) || ccw(c, b, x) || ccw(a, c, x))
+    };
+    // best[i][j]: the best worst shape of the sub-polygon i..=j (closed by i-j).
+    let mut best = vec![vec![f64::NEG_INFINITY; n]; n];
+    let mut pick = vec![vec![usize::MAX; n]; n];
+    for i in 0..n - 1 {
+        best[i][i + 1] = f64::INFINITY;
+    }
+    for len in 2..n {
+        for i in 0..n - len {
+            let j = i + len;
+            for k in i + 1..j {
+                if best[i][k] == f64::NEG_INFINITY || best[k][j] == f64::NEG_INFINITY {
+                    continue;
+                }
+                if !ok(i, k, j) {
+                    continue;
+                }
+                let q = best[i][k]
+                    .min(best[k][j])
+                    .min(shape(poly[i], poly[k], poly[j]));
+                if q > best[i][j] {
+                    best[i][j] = q;
+                    pick[i][j] = k;
+                }
+            }
         }
-        out.push([p[0], p[1], p[2]]);
+    }
+    if best[0][n - 1] == f64::NEG_INFINITY {
+        return None;
+    }
+    let mut out = Vec::with_capacity(n - 2);
+    let mut stack = vec![(0, n - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j <= i + 1 {
+            continue;
+        }
+        let k = pick[i][j];
+        out.push([poly[i], poly[k], poly[j]]);
+        stack.push((i, k));
+        stack.push((k, j));
     }
     Some(out)
 }
@@ -935,6 +980,34 @@ mod tests {
         });
         let r = r.unwrap();
         assert!(r.pts.len() > 6, "{} points", r.pts.len());
+    }
+
+    /// A fan around a removed point with a run of collinear points (a split edge): the
+    /// triangulation joins the run to the far vertex, never to itself.
+    #[test]
+    fn polygon_runs_of_collinear_points_join_across() {
+        let p: Vec<P3> = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [1.5, 1.0, 0.0],
+        ];
+        let (proj, sign) = projection_of(p[0], p[3], p[4]).unwrap();
+        let ccw = |a: u32, b: u32, c: u32| {
+            proj.orient2d(p[a as usize], p[b as usize], p[c as usize]) == sign
+        };
+        let shape = |a: u32, b: u32, c: u32| tri_shape(p[a as usize], p[b as usize], p[c as usize]);
+        // Starting anywhere on the cycle.
+        for r in 0..5 {
+            let poly: Vec<u32> = (0..5).map(|k| ((k + r) % 5) as u32).collect();
+            let t = triangulate_polygon(&poly, ccw, shape).unwrap();
+            assert_eq!(t.len(), 3);
+            for x in &t {
+                assert!(ccw(x[0], x[1], x[2]), "{x:?}");
+                assert!(x.contains(&4), "{x:?} does not use the apex");
+            }
+        }
     }
 
     /// Whole CAD parts (OpenSCAD exports) filled from their vertices alone: the

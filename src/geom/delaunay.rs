@@ -348,6 +348,39 @@ impl Delaunay {
         self.positive(t) && !self.flat_by_construction(t)
     }
 
+    /// The input points an added point stands for (itself for an input point), for
+    /// every point of `vs`, sorted; and whether any of `vs` is an added point.
+    fn supports(&self, vs: &[u32]) -> (Vec<u32>, bool) {
+        let mut sup: Vec<u32> = Vec::with_capacity(3 * vs.len());
+        let mut added = false;
+        for &v in vs {
+            if let Some(e) = self.on_line.get(&v) {
+                sup.extend_from_slice(e);
+                added = true;
+            } else if let Some(f) = self.on_face.get(&v) {
+                sup.extend_from_slice(f);
+                added = true;
+            } else {
+                sup.push(v);
+            }
+        }
+        sup.sort_unstable();
+        sup.dedup();
+        (sup, added)
+    }
+
+    /// Three points on one line by construction (added points on one input edge with
+    /// its ends), whatever their rounded positions say.
+    pub(crate) fn collinear_by_construction(&self, t: [u32; 3]) -> bool {
+        let (sup, added) = self.supports(&t);
+        if !added {
+            return false;
+        }
+        let p: Vec<P3> = sup.iter().map(|&v| self.p(v)).collect();
+        (1..p.len())
+            .all(|i| (i + 1..p.len()).all(|j| super::predicates::collinear(p[0], p[i], p[j])))
+    }
+
     fn flat_by_construction(&self, t: [u32; 4]) -> bool {
         let mut sup: Vec<u32> = Vec::with_capacity(12);
         let mut added = false;
