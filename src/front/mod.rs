@@ -618,16 +618,26 @@ impl<'a> Mesher<'a> {
                 continue;
             }
             // Stuck at every level: close its cavity exactly if it is small...
-            // ...or, where the search cannot, by the constrained fill...
-            if let Some(comp) = self.component(fid, constrained::MAX_FILL_FACES) {
-                if comp.len() <= cavity::MAX_CAVITY_FACES && self.fill_cavity(&comp) {
+            // ...or, where the front is about to give up, by the constrained fill (it
+            // closes what the search cannot; where local remeshing works, the remeshed
+            // front makes better tets).
+            let comp = self.component(fid, constrained::MAX_FILL_FACES);
+            if let Some(c) = &comp {
+                if c.len() <= cavity::MAX_CAVITY_FACES && self.fill_cavity(c) {
                     self.stats.cavities += 1;
                     continue;
                 }
-                let fixed = self.fixed_around(&comp);
-                if self.use_fill && self.constrained_fill(&comp, &fixed) {
-                    self.stats.constrained += 1;
-                    continue;
+            }
+            let giving_up = self.stats.repairs + 1 >= max_repairs
+                || self.stats.repairs + 1 - self.fewest_open.1 >= self.max_repairs_without_progress
+                || self.repair_count(fid) >= repair::MAX_REPAIRS_PER_REGION;
+            if let Some(c) = &comp {
+                if self.use_fill && giving_up {
+                    let fixed = self.fixed_around(c);
+                    if self.constrained_fill(c, &fixed) {
+                        self.stats.constrained += 1;
+                        continue;
+                    }
                 }
             }
             // ...else, where remeshing has not helped, accept a tet the optimizer must
@@ -1211,13 +1221,15 @@ mod tests {
     }
 
     #[test]
-    fn the_constrained_fill_closes_the_screws_stuck_cavity() {
+    fn the_constrained_fill_closes_where_the_front_would_give_up() {
         FILL_OFF.with(|c| c.set(false));
         let s = data_surface("screw");
         let opts = Options::default();
         let size = crate::generate::size_field(&s, &opts);
+        // No local remeshing allowed: without the fill this gives up (the next test).
         let mut m = Mesher::new(s.nodes(), s.triangles(), &opts, &size);
-        m.run(&mut |_, _| false).expect("the screw closes");
+        m.max_repairs_without_progress = 0;
+        m.run(&mut |_, _| false).expect("the fill closes the screw");
         assert!(m.stats.constrained > 0, "{:?}", m.stats);
         assert_eq!(m.stats.repairs, 0, "{:?}", m.stats);
         assert_eq!(m.open_faces, 0);

@@ -9,7 +9,7 @@ use crate::geom::vec3::*;
 use crate::Result;
 
 /// Repairs allowed around one place before the front gives up there.
-const MAX_REPAIRS_PER_REGION: u32 = 12;
+pub(super) const MAX_REPAIRS_PER_REGION: u32 = 12;
 
 impl Mesher<'_> {
     fn repair_key(&self, fid: u32) -> (i32, i32, i32) {

@@ -49,6 +49,9 @@ pub(crate) fn fill(pts: &[P3], faces: &[[u32; 3]]) -> Result<Filled, &'static st
 /// Flips tried per segment or face to clear nearly flat tets out of a split's way.
 const MAX_UNBLOCK: usize = 64;
 
+/// Rounds over the Steiner points not yet moved off the surface.
+const MOVE_ROUNDS: usize = 4;
+
 struct Cdt<'a> {
     dt: Delaunay,
     faces: &'a [[u32; 3]],
@@ -407,55 +410,85 @@ impl<'a> Cdt<'a> {
                 on_edge.insert(v, edge_faces.get(e).copied().unwrap_or(2));
             }
         }
-        for s in first..last {
-            let mut left = on_edge.get(&s).copied().unwrap_or(1);
-            let mut seen: HashSet<u32> = HashSet::new();
-            while left > 0 {
-                let star = self.dt.star(s);
-                let star = if star.iter().any(|t| seen.contains(t)) || star.is_empty() {
-                    // Another pocket at this point: its tets are not linked to the first.
-                    (0..self.dt.tets.len() as u32)
-                        .filter(|&t| {
-                            self.dt.alive[t as usize]
-                                && self.dt.tets[t as usize].contains(&s)
-                                && !seen.contains(&t)
-                        })
-                        .collect::<Vec<_>>()
-                } else {
-                    star
-                };
-                if star.is_empty() {
-                    break;
+        // Each point's pockets left to move it off (2 where two pockets touch at an edge).
+        let mut left: Vec<(u32, usize)> = (first..last)
+            .map(|s| (s, on_edge.get(&s).copied().unwrap_or(1)))
+            .collect();
+        // A point whose new star has no kernel yet may get one once its neighbours have
+        // moved: a few rounds over those left.
+        for _ in 0..MOVE_ROUNDS {
+            let mut stuck = Vec::new();
+            for &(s, n) in &left {
+                let n = self.remove_one(s, n)?;
+                if n > 0 {
+                    stuck.push((s, n));
                 }
-                let comp = self.component(s, &star);
-                let mut groups = 0;
-                for attempt in 0..=MAX_UNBLOCK {
-                    let comp = if attempt == 0 {
-                        comp.clone()
-                    } else {
-                        let star = self.dt.star(s);
-                        if star.is_empty() {
-                            break;
-                        }
-                        self.component(s, &star)
-                    };
-                    match self.move_off(s, &comp, attempt < MAX_UNBLOCK)? {
-                        0 => continue,
-                        usize::MAX => {
-                            groups = self.move_off(s, &comp, false)?;
-                            break;
-                        }
-                        g => {
-                            groups = g;
-                            break;
-                        }
-                    }
-                }
-                seen.extend(comp.iter().copied());
-                left = left.saturating_sub(groups);
+            }
+            let progress = stuck.len() < left.len();
+            left = stuck;
+            if left.is_empty() || !progress {
+                break;
             }
         }
-        Ok(())
+        if left.is_empty() {
+            Ok(())
+        } else {
+            Err("no interior point sees a Steiner point's star")
+        }
+    }
+
+    /// Move Steiner point `s` off the surface in each of its `pockets`; returns how many
+    /// are left (its new star there has no kernel).
+    fn remove_one(&mut self, s: u32, pockets: usize) -> Result<usize, &'static str> {
+        let mut left = pockets;
+        let mut seen: HashSet<u32> = HashSet::new();
+        let mut failed = 0;
+        while left > failed {
+            let star = self.dt.star(s);
+            let star = if star.iter().any(|t| seen.contains(t)) || star.is_empty() {
+                // Another pocket at this point: its tets are not linked to the first.
+                (0..self.dt.tets.len() as u32)
+                    .filter(|&t| {
+                        self.dt.alive[t as usize]
+                            && self.dt.tets[t as usize].contains(&s)
+                            && !seen.contains(&t)
+                    })
+                    .collect::<Vec<_>>()
+            } else {
+                star
+            };
+            if star.is_empty() {
+                return Ok(0);
+            }
+            let mut comp = self.component(s, &star);
+            let mut moved = None;
+            for attempt in 0..=MAX_UNBLOCK {
+                if attempt > 0 {
+                    let star = self.dt.star(s);
+                    if star.is_empty() {
+                        break;
+                    }
+                    comp = self.component(s, &star);
+                }
+                match self.move_off(s, &comp, attempt < MAX_UNBLOCK)? {
+                    Some(0) => continue,
+                    Some(usize::MAX) => {
+                        moved = self.move_off(s, &comp, false)?;
+                        break;
+                    }
+                    g => {
+                        moved = g;
+                        break;
+                    }
+                }
+            }
+            seen.extend(comp.iter().copied());
+            match moved {
+                Some(g) => left = left.saturating_sub(g),
+                None => failed += 1,
+            }
+        }
+        Ok(left)
     }
 
     /// The tets of `star` (all containing `s`) linked to its first through faces at `s`.
@@ -478,10 +511,15 @@ impl<'a> Cdt<'a> {
     }
 
     /// Move Steiner point `s` off the surface within the tets `comp` around it. Returns
-    /// how many surface triangles it was on there.
-    /// With `unblock`, a point that cannot be placed makes it flip the link tets in the
-    /// way instead and return 0 (or usize::MAX when no flip applies).
-    fn move_off(&mut self, s: u32, comp: &[u32], unblock: bool) -> Result<usize, &'static str> {
+    /// how many surface triangles it was on there, or None (nothing changed) when no
+    /// point sees its new star. With `unblock`, such a point makes it flip the link tets
+    /// in the way instead and return 0 (or usize::MAX when no flip applies).
+    fn move_off(
+        &mut self,
+        s: u32,
+        comp: &[u32],
+        unblock: bool,
+    ) -> Result<Option<usize>, &'static str> {
         // The constraint faces at s, outward, grouped by input face: edges x -> y of
         // the faces (s, x, y).
         let mut groups: BTreeMap<usize, Vec<[u32; 2]>> = BTreeMap::new();
@@ -610,14 +648,15 @@ impl<'a> Cdt<'a> {
                 .map(|(&t, _)| t)
                 .collect();
             self.dt.pop_point();
-            return Ok(if self.dt.flip_away(&bad) {
+            return Ok(Some(if self.dt.flip_away(&bad) {
                 0
             } else {
                 usize::MAX
-            });
+            }));
         }
         if !placed {
-            return Err("no interior point sees a Steiner point's star");
+            self.dt.pop_point();
+            return Ok(None);
         }
         self.dt.replace(comp, &tets);
         for (g, i) in new_faces {
@@ -627,7 +666,7 @@ impl<'a> Cdt<'a> {
             self.dt.fixed_faces.insert(sorted3(g));
             self.parent.insert(sorted3(g), i);
         }
-        Ok(groups.len())
+        Ok(Some(groups.len()))
     }
 
     fn result(&self) -> Result<Filled, &'static str> {

@@ -345,7 +345,11 @@ impl Delaunay {
     /// (an added point standing for the input edge or face it was put on) all on one
     /// plane of input points, exactly, so that only rounding makes it positive.
     pub(crate) fn valid_new(&self, t: [u32; 4]) -> bool {
-        self.positive(t) && !self.flat_by_construction(t)
+        self.positive(t)
+            && !self.flat_by_construction(t)
+            && !FACES
+                .iter()
+                .any(|f| self.collinear_by_construction(f.map(|j| t[j])))
     }
 
     /// The input points an added point stands for (itself for an input point), for
