@@ -242,12 +242,7 @@ impl Mesher<'_> {
     /// Try to tetrahedralize the cavity made of live front faces `comp`; on success the
     /// tets are inserted and true is returned.
     pub(super) fn fill_cavity(&mut self, comp: &[u32]) -> bool {
-        let mut verts: Vec<u32> = comp
-            .iter()
-            .flat_map(|&f| self.faces[f as usize].v)
-            .collect();
-        verts.sort_unstable();
-        verts.dedup();
+        let verts = self.cavity_vertices(comp);
         let open: Vec<FaceRef> = comp
             .iter()
             .map(|&f| FaceRef {
@@ -309,6 +304,17 @@ impl Mesher<'_> {
             }
         }
         false
+    }
+
+    /// The vertices of front faces `comp`, sorted.
+    pub(super) fn cavity_vertices(&self, comp: &[u32]) -> Vec<u32> {
+        let mut verts: Vec<u32> = comp
+            .iter()
+            .flat_map(|&f| self.faces[f as usize].v)
+            .collect();
+        verts.sort_unstable();
+        verts.dedup();
+        verts
     }
 
     /// The live front faces other than `comp`'s in the box of `comp`'s vertices: never to

@@ -14,12 +14,7 @@ impl Mesher<'_> {
     /// Fill the cavity bounded by live front faces `comp`; `fixed` are the other live
     /// front faces nearby, which no new tet may touch. True when the tets are inserted.
     pub(super) fn constrained_fill(&mut self, comp: &[u32], fixed: &[FaceRef]) -> bool {
-        let mut verts: Vec<u32> = comp
-            .iter()
-            .flat_map(|&f| self.faces[f as usize].v)
-            .collect();
-        verts.sort_unstable();
-        verts.dedup();
+        let verts = self.cavity_vertices(comp);
         let local = |v: u32| verts.binary_search(&v).map_or(u32::MAX, |i| i as u32);
         let pts: Vec<P3> = verts.iter().map(|&v| self.pts[v as usize]).collect();
         // Front faces have the unmeshed region on their positive side, as the fill wants.

@@ -206,56 +206,19 @@ impl Delaunay {
                 }
             }
         }
-        // Boundary faces of the cavity -> new tets (face, q).
-        let mut edge_of: HashMap<(u32, u32), (u32, usize)> = HashMap::new();
-        let mut made = Vec::new();
+        // The cavity's boundary faces joined to q: each face's normal points out of its
+        // tet and q is inside the cavity, so (f0, f2, f1, q) is positive.
+        let mut new = Vec::new();
         for &t in &cavity {
             let tv = self.tets[t as usize];
             for (j, f) in FACES.iter().enumerate() {
                 let nb = self.adj[t as usize][j];
-                if nb != NONE && in_cav.contains_key(&nb) {
-                    continue;
+                if nb == NONE || !in_cav.contains_key(&nb) {
+                    new.push([tv[f[0]], tv[f[2]], tv[f[1]], i]);
                 }
-                // New tet: (f0, f1, f2, q) with f's outward normal pointing at q? The face
-                // normal points out of t, and q is inside the cavity: q is on the inner
-                // side, so (f0, f2, f1, q) is positive.
-                let a = tv[f[0]];
-                let b = tv[f[2]];
-                let c = tv[f[1]];
-                let nt = self.tets.len() as u32;
-                self.tets.push([a, b, c, i]);
-                // Face 3 (opposite q) is (a, b, c) -> outer neighbour nb.
-                self.adj.push([NONE, NONE, NONE, nb]);
-                self.alive.push(true);
-                if nb != NONE {
-                    let back = (0..4).find(|&m| self.adj[nb as usize][m] == t).unwrap_or(0);
-                    self.adj[nb as usize][back] = nt;
-                }
-                // Faces 0, 1, 2 of the new tet contain q and the edge opposite a, b, c.
-                let tvn = [a, b, c];
-                for m in 0..3 {
-                    let e0 = tvn[(m + 1) % 3];
-                    let e1 = tvn[(m + 2) % 3];
-                    let key = if e0 < e1 { (e0, e1) } else { (e1, e0) };
-                    if let Some((ot, om)) = edge_of.remove(&key) {
-                        self.adj[nt as usize][m] = ot;
-                        self.adj[ot as usize][om] = nt;
-                    } else {
-                        edge_of.insert(key, (nt, m));
-                    }
-                }
-                made.push(nt);
             }
         }
-        for &t in &cavity {
-            self.alive[t as usize] = false;
-        }
-        for &t in &made {
-            for v in self.tets[t as usize] {
-                self.vt[v as usize] = t;
-            }
-        }
-        self.last = *made.last().unwrap_or(&start);
+        self.replace(&cavity, &new);
         true
     }
 
