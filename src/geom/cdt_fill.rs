@@ -696,7 +696,7 @@ impl<'a> Cdt<'a> {
                 *o = if (v as usize) < n {
                     v
                 } else if v >= first {
-                    if self.chains_or_inner_has(v) {
+                    if self.dt.on_line.contains_key(&v) || self.dt.on_face.contains_key(&v) {
                         return Err("a Steiner point stayed on the surface");
                     }
                     *map.entry(v).or_insert_with(|| {
@@ -731,10 +731,6 @@ impl<'a> Cdt<'a> {
             return Err("the filled tets overlap");
         }
         Ok(Filled { pts, tets })
-    }
-
-    fn chains_or_inner_has(&self, v: u32) -> bool {
-        self.inner.iter().any(|x| x.contains(&v)) || self.chains.values().any(|c| c.contains(&v))
     }
 }
 
@@ -917,7 +913,7 @@ mod tests {
 
     /// Fill `faces` (outward, as surfaces are stored) and check the result: positive tets,
     /// boundary exactly the input, volume the enclosed one.
-    pub(crate) fn fill_and_check(pts: &[P3], outward: &[[u32; 3]]) -> Result<Filled, String> {
+    fn fill_and_check(pts: &[P3], outward: &[[u32; 3]]) -> Result<Filled, String> {
         let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
         let r = fill(pts, &faces).map_err(|e| e.to_string())?;
         assert_eq!(&r.pts[..pts.len()], pts);

@@ -349,24 +349,10 @@ impl Delaunay {
     }
 
     fn flat_by_construction(&self, t: [u32; 4]) -> bool {
-        let mut sup: Vec<u32> = Vec::with_capacity(12);
-        let mut added = false;
-        for &v in &t {
-            if let Some(e) = self.on_line.get(&v) {
-                sup.extend_from_slice(e);
-                added = true;
-            } else if let Some(f) = self.on_face.get(&v) {
-                sup.extend_from_slice(f);
-                added = true;
-            } else {
-                sup.push(v);
-            }
-        }
+        let (sup, added) = self.supports(&t);
         if !added {
             return false;
         }
-        sup.sort_unstable();
-        sup.dedup();
         let p: Vec<P3> = sup.iter().map(|&v| self.p(v)).collect();
         // Three points not on a line, then every other point on their plane.
         let base = (1..p.len()).find_map(|i| {
