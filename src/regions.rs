@@ -731,6 +731,7 @@ fn add_front(a: &mut FrontStats, b: &FrontStats) {
     a.deleted += b.deleted;
     a.cavities += b.cavities;
     a.constrained += b.constrained;
+    a.whole_fill |= b.whole_fill;
     a.p2_invalid += b.p2_invalid;
     a.restarts += b.restarts;
     a.alpha = b.alpha;

@@ -17,6 +17,7 @@ mod queue;
 mod repair;
 pub mod size;
 pub mod validity;
+mod whole_fill;
 
 use crate::geom::bezier::certify;
 use crate::geom::predicates::orient3d;
@@ -72,6 +73,9 @@ pub struct FrontStats {
     pub alpha: f64,
     /// Size field factor of the run that succeeded.
     pub size_scale: f64,
+    /// No front attempt closed: the whole region was filled at once (interior points
+    /// from the size field, then the constrained fill; see `whole_fill`).
+    pub whole_fill: bool,
 }
 
 #[derive(Clone, Copy)]
@@ -232,6 +236,19 @@ const MIN_BOUNDARY_GAP_DEG: f64 = 5.0;
 thread_local! {
     /// Tests of the repair and give-up path turn the constrained fill off on their thread.
     static FILL_OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests only: every front attempt fails at once, so that the whole fill runs.
+    static FRONT_OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+fn front_enabled() -> bool {
+    #[cfg(test)]
+    {
+        !FRONT_OFF.with(|c| c.get())
+    }
+    #[cfg(not(test))]
+    {
+        true
+    }
 }
 
 fn fill_enabled() -> bool {
@@ -1165,7 +1182,12 @@ pub fn run_front(
 ) -> Result<FrontOutput> {
     let mut failures = Vec::new();
     let mut last_partial = None;
-    for (attempt, &(fa, fs)) in RESTARTS.iter().enumerate().skip(first) {
+    let attempts = if front_enabled() {
+        RESTARTS.len()
+    } else {
+        first
+    };
+    for (attempt, &(fa, fs)) in RESTARTS.iter().enumerate().take(attempts).skip(first) {
         let mut m = Mesher::new(surf_nodes, surf_tris, opts, size);
         m.alpha = opts.alpha * fa;
         m.size_scale = fs;
@@ -1199,14 +1221,26 @@ pub fn run_front(
             Err(e) => return Err(e),
         }
     }
-    Err(Error::MeshingFailed {
-        msg: format!(
-            "{} attempts failed: {}",
-            failures.len(),
-            failures.join("; ")
-        ),
-        partial: last_partial,
-    })
+    // Every attempt failed: the whole region at once, boundary kept.
+    if progress(0.0, "whole fill") {
+        return Err(Error::Cancelled);
+    }
+    match whole_fill::whole_fill(surf_nodes, surf_tris, size) {
+        Ok(mut out) => {
+            out.stats.restarts = (RESTARTS.len() - 1) as u32;
+            out.stats.alpha = opts.alpha;
+            out.stats.size_scale = 1.0;
+            Ok(out)
+        }
+        Err(why) => Err(Error::MeshingFailed {
+            msg: format!(
+                "{} attempts failed: {}; the whole fill failed too: {why}",
+                failures.len(),
+                failures.join("; ")
+            ),
+            partial: last_partial,
+        }),
+    }
 }
 
 #[cfg(test)]
@@ -1218,6 +1252,26 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("tests/data/{name}_p2.msh"));
         crate::io::read_any_surface(&path, &Default::default()).expect(name)
+    }
+
+    /// The whole fill's tets go through the linear and high-order stages and the final
+    /// checks like the front's: a certified, conforming mesh of the sphere.
+    #[test]
+    fn where_no_front_attempt_closes_the_whole_fill_meshes() {
+        FRONT_OFF.with(|c| c.set(true));
+        let s = data_surface("sphere");
+        let g = crate::generate::generate(&s, &Options::default());
+        FRONT_OFF.with(|c| c.set(false));
+        let g = g.expect("the whole fill meshes the sphere");
+        assert!(g.front.whole_fill, "{:?}", g.front);
+        assert_eq!(g.front.restarts as usize, RESTARTS.len() - 1);
+        let q = &g.report.quality;
+        assert_eq!(g.report.num_invalid, 0);
+        assert!(
+            q.scaled_jacobian_certified.min > 0.3,
+            "{:?}",
+            q.scaled_jacobian_certified
+        );
     }
 
     #[test]

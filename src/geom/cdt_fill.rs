@@ -121,28 +121,42 @@ impl<'a> Cdt<'a> {
     fn recover_segment(&mut self, a: u32, b: u32) -> Result<Vec<u32>, &'static str> {
         let mut chain = vec![a];
         let mut cur = a;
+        // The chain's next points to reach, the last first: b, and any point inserted on
+        // the segment that did not join the current end.
+        let mut goals = vec![b];
         let mut flips = 0;
         for _ in 0..1_000_000 {
-            if self.dt.recover_edge(cur, b, 32) || self.dt.recover_edge_any(cur, b, 32) {
-                chain.push(b);
-                self.dt.fixed_edges.insert(sorted2(cur, b));
+            let Some(&goal) = goals.last() else {
                 return Ok(chain);
+            };
+            if self.dt.recover_edge(cur, goal, 32) || self.dt.recover_edge_any(cur, goal, 32) {
+                chain.push(goal);
+                self.dt.fixed_edges.insert(sorted2(cur, goal));
+                cur = goal;
+                goals.pop();
+                continue;
             }
             let (t, k) = self
                 .dt
-                .leaving(cur, b)
+                .leaving(cur, goal)
                 .ok_or("no tet leaves a segment's end toward its other end")?;
             let tv = self.dt.tets[t as usize];
             let f = FACES[k].map(|j| tv[j]);
             let fp = f.map(|v| self.dt.p(v));
-            let (pc, pb) = (self.dt.p(cur), self.dt.p(b));
+            let (pc, pb) = (self.dt.p(cur), self.dt.p(goal));
             let o = [0, 1, 2].map(|e| orient3d(pc, pb, fp[e], fp[(e + 1) % 3]));
             // The new point's edge, known to the flatness test before the split.
             let next = self.dt.next_id();
             self.dt.on_line.insert(next, sorted2(a, b));
-            let split = match o.iter().filter(|&&x| x == 0).count() {
+            let zeros = o.iter().filter(|&&x| x == 0).count();
+            let on_edge = o.iter().position(|&x| x == 0).unwrap_or(0);
+            let p = match zeros {
+                0 => segment_plane(pc, pb, fp),
+                1 => segment_line(pc, pb, fp[on_edge], fp[(on_edge + 1) % 3]),
+                _ => return Err("a surface edge passes through a vertex"),
+            };
+            let split = match zeros {
                 0 => {
-                    let p = segment_plane(pc, pb, fp);
                     // Rounded next to an edge of the face, a face split inverts a tet:
                     // split the nearest edges instead.
                     self.dt.split_face(t, k, p).or_else(|mut bad| {
@@ -162,29 +176,35 @@ impl<'a> Cdt<'a> {
                         Err(bad)
                     })
                 }
-                1 => {
-                    let e = o.iter().position(|&x| x == 0).unwrap_or(0);
-                    let (x, y) = (f[e], f[(e + 1) % 3]);
-                    let p = segment_line(pc, pb, self.dt.p(x), self.dt.p(y));
-                    self.dt.split_edge(x, y, p)
-                }
-                _ => return Err("a surface edge passes through a vertex"),
+                _ => self.dt.split_edge(f[on_edge], f[(on_edge + 1) % 3], p),
             };
             let s = match split {
                 Ok(s) => s,
                 Err(bad) => {
-                    self.dt.on_line.remove(&next);
-                    // Nearly flat tets in the way: flip them and walk again.
+                    // Nearly flat tets in the way: flip them and walk again...
                     flips += 1;
                     if flips <= MAX_UNBLOCK && self.dt.flip_away(&bad) {
+                        self.dt.on_line.remove(&next);
                         continue;
                     }
-                    return Err("a Steiner point on a surface edge would invert a tet");
+                    // ...else insert the point by Bowyer-Watson, which takes every tet
+                    // around a nearby edge into its cavity.
+                    match self.dt.insert_point(p) {
+                        Some(s) => s,
+                        None => {
+                            self.dt.on_line.remove(&next);
+                            return Err("a Steiner point on a surface edge would invert a tet");
+                        }
+                    }
                 }
             };
-            self.dt.fixed_edges.insert(sorted2(cur, s));
-            chain.push(s);
-            cur = s;
+            if self.dt.has_edge(cur, s) {
+                self.dt.fixed_edges.insert(sorted2(cur, s));
+                chain.push(s);
+                cur = s;
+            } else {
+                goals.push(s);
+            }
         }
         Err("edge recovery did not end")
     }
@@ -267,12 +287,18 @@ impl<'a> Cdt<'a> {
             let s = match self.dt.split_edge(u, v, p) {
                 Ok(s) => s,
                 Err(bad) => {
-                    self.dt.on_face.remove(&next);
                     flips += 1;
                     if flips <= MAX_UNBLOCK && self.dt.flip_away(&bad) {
+                        self.dt.on_face.remove(&next);
                         continue;
                     }
-                    return Err("a Steiner point in a surface triangle would invert a tet");
+                    match self.dt.insert_point(p) {
+                        Some(s) => s,
+                        None => {
+                            self.dt.on_face.remove(&next);
+                            return Err("a Steiner point in a surface triangle would invert a tet");
+                        }
+                    }
                 }
             };
             on.insert(s);

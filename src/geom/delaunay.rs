@@ -621,6 +621,129 @@ impl Delaunay {
         Ok(s)
     }
 
+    /// Insert a new point at `p` by Bowyer–Watson in a triangulation that may no longer be
+    /// Delaunay. The cavity is the tets whose circumsphere holds `p`, grown from the tet
+    /// holding it without crossing a fixed face, then shrunk (tets not holding `p` taken
+    /// out) until `p` sees every face of it, no fixed edge and no point is inside it.
+    /// Unlike a face or edge split next to a nearly flat tet, every tet around a point
+    /// near an edge is in the cavity, so no new tet is thin there. None (nothing changed)
+    /// if the tets holding `p` themselves are in the way, or a new tet would be one
+    /// [`Delaunay::valid_new`] refuses.
+    pub(crate) fn insert_point(&mut self, p: P3) -> Option<u32> {
+        let start = self.locate(p);
+        let tv = self.tets[start as usize];
+        if !self.alive[start as usize] || tv.iter().any(|&v| self.p(v) == p) {
+            return None;
+        }
+        let fixed_face = |dt: &Delaunay, t: u32, j: usize| {
+            dt.fixed_faces
+                .contains(&sorted3(FACES[j].map(|i| dt.tets[t as usize][i])))
+        };
+        // The point, known to the flatness tests from here on.
+        let s = self.add_point(p);
+        // The new tet on face j of t, and whether p is on that face: exactly, or by
+        // construction (the support points of both on one plane).
+        let new_tet = |dt: &Delaunay, t: u32, j: usize| {
+            let tv = dt.tets[t as usize];
+            let f = FACES[j];
+            [tv[f[0]], tv[f[2]], tv[f[1]], s]
+        };
+        let on_face = |dt: &Delaunay, t: u32, j: usize| {
+            let n = new_tet(dt, t, j);
+            !dt.positive(n) && orient3d(dt.p(n[0]), dt.p(n[1]), dt.p(n[2]), p) == 0
+                || dt.flat_by_construction(n)
+        };
+        let holds = |dt: &Delaunay, t: u32| {
+            (0..4).all(|j| dt.positive(new_tet(dt, t, j)) || on_face(dt, t, j))
+        };
+        let mut cav = vec![start];
+        let mut in_cav: HashSet<u32> = HashSet::from([start]);
+        let mut k = 0;
+        while k < cav.len() {
+            let t = cav[k];
+            k += 1;
+            for j in 0..4 {
+                let nb = self.adj[t as usize][j];
+                if nb == NONE || in_cav.contains(&nb) || fixed_face(self, t, j) {
+                    continue;
+                }
+                // Every tet holding p, and those the sphere test takes.
+                if (holds(self, t) && on_face(self, t, j)) || self.in_sphere(nb, p) > 0 {
+                    in_cav.insert(nb);
+                    cav.push(nb);
+                }
+            }
+        }
+        let fail = |dt: &mut Delaunay| {
+            dt.pop_point();
+            None
+        };
+        loop {
+            let mut out: Vec<u32> = Vec::new();
+            let mut bound_edges: HashSet<[u32; 2]> = HashSet::new();
+            let mut bound_pts: HashSet<u32> = HashSet::new();
+            for &t in &cav {
+                for j in 0..4 {
+                    let nb = self.adj[t as usize][j];
+                    if nb != NONE && in_cav.contains(&nb) {
+                        if fixed_face(self, t, j) {
+                            out.push(t);
+                        }
+                        continue;
+                    }
+                    let n = new_tet(self, t, j);
+                    if !self.valid_new(n) {
+                        out.push(t);
+                    }
+                    for e in 0..3 {
+                        bound_edges.insert(sorted2(n[e], n[(e + 1) % 3]));
+                    }
+                    bound_pts.extend(&n[..3]);
+                }
+            }
+            if out.is_empty() {
+                for &t in &cav {
+                    let tv = self.tets[t as usize];
+                    let inner_edge = (0..4).any(|a| {
+                        (a + 1..4).any(|b| {
+                            let e = sorted2(tv[a], tv[b]);
+                            self.fixed_edges.contains(&e) && !bound_edges.contains(&e)
+                        })
+                    });
+                    if inner_edge || tv.iter().any(|v| !bound_pts.contains(v)) {
+                        out.push(t);
+                    }
+                }
+            }
+            if out.is_empty() {
+                break;
+            }
+            let mut removed = false;
+            for t in out {
+                // A tet holding p cannot go.
+                if in_cav.contains(&t) && !holds(self, t) {
+                    in_cav.remove(&t);
+                    removed = true;
+                }
+            }
+            if !removed {
+                return fail(self);
+            }
+            cav.retain(|t| in_cav.contains(t));
+        }
+        let mut new = Vec::new();
+        for &t in &cav {
+            for j in 0..4 {
+                let nb = self.adj[t as usize][j];
+                if nb == NONE || !in_cav.contains(&nb) {
+                    new.push(new_tet(self, t, j));
+                }
+            }
+        }
+        self.replace(&cav, &new);
+        Some(s)
+    }
+
     /// Split face `k` of tet `t` (and the tet behind it) at `p`, 2 tets to 6.
     pub(crate) fn split_face(&mut self, t: u32, k: usize, p: P3) -> Result<u32, Vec<u32>> {
         let u = self.adj[t as usize][k];
@@ -862,6 +985,50 @@ mod tests {
         let dt = Delaunay::new(&pts);
         check_delaunay(&dt);
         assert!(dt.interior_tets().count() > 200);
+    }
+
+    /// Points inserted one by one into a Delaunay triangulation keep it Delaunay; with
+    /// fixed edges, they keep those edges, every tet positive and the volume.
+    #[test]
+    fn inserted_points_keep_the_triangulation_and_its_fixed_edges() {
+        let mut s = 0x2545f4914f6cdd1du64;
+        let pts: Vec<P3> = (0..150)
+            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
+            .collect();
+        let volume = |dt: &Delaunay| -> f64 {
+            (0..dt.tets.len())
+                .filter(|&t| dt.alive[t])
+                .map(|t| {
+                    let p = dt.tets[t].map(|v| dt.pts[v as usize]);
+                    crate::geom::vec3::tet_det(p[0], p[1], p[2], p[3])
+                })
+                .sum()
+        };
+        let mut dt = Delaunay::new(&pts);
+        for _ in 0..60 {
+            let q = [rng(&mut s), rng(&mut s), rng(&mut s)];
+            assert!(dt.insert_point(q).is_some());
+        }
+        check_delaunay(&dt);
+        let mut dt = Delaunay::new(&pts);
+        let v0 = volume(&dt);
+        let fixed: Vec<[u32; 2]> = (0..40u32)
+            .filter_map(|a| (a + 1..150).find(|&b| dt.has_edge(a, b)).map(|b| [a, b]))
+            .collect();
+        dt.fixed_edges.extend(fixed.iter().copied());
+        let mut added = 0;
+        for _ in 0..200 {
+            let q = [rng(&mut s), rng(&mut s), rng(&mut s)];
+            added += usize::from(dt.insert_point(q).is_some());
+        }
+        assert!(added > 150, "{added} of 200 inserted");
+        for e in &fixed {
+            assert!(dt.has_edge(e[0], e[1]), "fixed edge {e:?} lost");
+        }
+        for t in (0..dt.tets.len()).filter(|&t| dt.alive[t]) {
+            assert!(dt.positive(dt.tets[t]), "tet {t}");
+        }
+        assert!((volume(&dt) - v0).abs() <= 1e-9 * v0);
     }
 
     #[test]

@@ -1,0 +1,246 @@
+//! The whole region at once, for a surface the front cannot close within its work budget:
+//! interior points from the size field, then the constrained fill
+//! ([`crate::geom::cdt_fill`]) of the surface's triangles with those points. The boundary
+//! is kept exactly (added points are strictly inside), and the linear and high-order
+//! stages improve the tets like the front's.
+//!
+//! The points are the centres and corners of a graded octree's leaves: a body-centred
+//! cubic lattice wherever the size is uniform, whose Delaunay tets are all alike and well
+//! shaped. A leaf is at most [`LEAF_PER_SIZE`] times the size at its centre; points
+//! nearer the surface than [`CLEARANCE`] times the size are dropped (the surface's own
+//! vertices are there), as are points outside (with the tets the fill discards).
+
+use super::grid::{Aabb, FaceGrid};
+use super::size::SizeField;
+use super::{FrontOutput, FrontStats};
+use crate::geom::cdt_fill;
+use crate::geom::distance::point_triangle_dist2;
+use crate::geom::vec3::P3;
+use std::collections::HashSet;
+
+/// Largest leaf side, as a multiple of the size at its centre. The lattice's edges are
+/// the side and 0.87 of it, and leaves are between half and all of this.
+const LEAF_PER_SIZE: f64 = 1.3;
+
+/// Interior points at least this many sizes from the surface.
+const CLEARANCE: f64 = 0.6;
+
+/// Octree depth limit (integer corner coordinates fit in 32 bits).
+const MAX_DEPTH: u32 = 24;
+
+/// Most interior candidate points (a size field far below the part's extent).
+const MAX_POINTS: usize = 20_000_000;
+
+/// Tetrahedralize the region bounded by the P2 surface's corner triangles, with interior
+/// points spaced by `size`. Err says why the fill could not go on.
+pub(crate) fn whole_fill(
+    surf_nodes: &[P3],
+    surf_tris: &[[u32; 6]],
+    size: &SizeField,
+) -> Result<FrontOutput, String> {
+    // The corner nodes, in local numbering.
+    let mut corners: Vec<u32> = surf_tris.iter().flat_map(|t| [t[0], t[1], t[2]]).collect();
+    corners.sort_unstable();
+    corners.dedup();
+    let local = |v: u32| corners.binary_search(&v).map_or(u32::MAX, |i| i as u32);
+    let mut pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
+    let n_corners = pts.len();
+    let interior = interior_points(&pts, surf_tris, &local, size)?;
+    pts.extend_from_slice(&interior);
+    // The fill wants the region on each face's positive side: the outward input reversed.
+    let faces: Vec<[u32; 3]> = surf_tris
+        .iter()
+        .map(|t| [local(t[0]), local(t[2]), local(t[1])])
+        .collect();
+    let filled = cdt_fill::fill(&pts, &faces).map_err(|e| e.to_string())?;
+    // Global ids: corners keep theirs; used interior and Steiner points follow the
+    // surface nodes in order of first use.
+    let mut out_pts = surf_nodes.to_vec();
+    let mut new_id = vec![u32::MAX; filled.pts.len()];
+    let mut tets = Vec::with_capacity(filled.tets.len());
+    for t in &filled.tets {
+        tets.push(t.map(|v| {
+            let v = v as usize;
+            if v < n_corners {
+                corners[v]
+            } else {
+                if new_id[v] == u32::MAX {
+                    new_id[v] = out_pts.len() as u32;
+                    out_pts.push(filled.pts[v]);
+                }
+                new_id[v]
+            }
+        }));
+    }
+    let quality = vec![f64::NAN; tets.len()];
+    Ok(FrontOutput {
+        pts: out_pts,
+        tets,
+        quality,
+        stats: FrontStats {
+            whole_fill: true,
+            ..FrontStats::default()
+        },
+    })
+}
+
+/// Octree leaf centres and corners in the surface's box, at least [`CLEARANCE`] sizes
+/// from every triangle, in depth-first (Morton) order, so that consecutive points are
+/// near each other for the Delaunay insertion's walk.
+fn interior_points(
+    corner_pts: &[P3],
+    surf_tris: &[[u32; 6]],
+    local: &dyn Fn(u32) -> u32,
+    size: &SizeField,
+) -> Result<Vec<P3>, String> {
+    let bounds = Aabb::of(corner_pts);
+    let ext = (0..3)
+        .map(|d| bounds.hi[d] - bounds.lo[d])
+        .fold(0.0, f64::max);
+    if ext.is_nan() || ext <= 0.0 {
+        return Err("the surface has no extent".into());
+    }
+    let tri_pts = |t: &[u32; 6]| [0, 1, 2].map(|k| corner_pts[local(t[k]) as usize]);
+    let mut mean_edge = 0.0;
+    for t in surf_tris {
+        let p = tri_pts(t);
+        mean_edge += crate::geom::vec3::dist(p[0], p[1]);
+    }
+    mean_edge /= surf_tris.len().max(1) as f64;
+    let mut grid = FaceGrid::new(bounds, 2.0 * mean_edge, (16 * surf_tris.len()).max(1 << 16));
+    for (i, t) in surf_tris.iter().enumerate() {
+        grid.insert(i as u32, &Aabb::of(&tri_pts(t)));
+    }
+    // Integer coordinates in units of the root side / 2^(MAX_DEPTH + 1): every leaf's
+    // corners and centre are whole, so shared points are found exactly.
+    let unit = ext / f64::from(1u32 << (MAX_DEPTH + 1));
+    let at = |c: [u64; 3]| -> P3 { [0, 1, 2].map(|d| bounds.lo[d] + c[d] as f64 * unit) };
+    let mut seen: HashSet<[u64; 3]> = HashSet::new();
+    let mut cand: Vec<P3> = Vec::new();
+    // (min corner, depth); children pushed in reverse Morton order, so popped in order.
+    let mut stack: Vec<([u64; 3], u32)> = vec![([0; 3], 0)];
+    while let Some((lo, depth)) = stack.pop() {
+        let half = 1u64 << (MAX_DEPTH - depth);
+        let side = ext / f64::from(1u32 << depth);
+        let centre = lo.map(|c| c + half);
+        if side > LEAF_PER_SIZE * size.at(at(centre)) && depth < MAX_DEPTH {
+            for k in (0..8u64).rev() {
+                let child = [0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * half);
+                stack.push((child, depth + 1));
+            }
+            continue;
+        }
+        let mut emit = |c: [u64; 3]| {
+            if seen.insert(c) {
+                cand.push(at(c));
+            }
+        };
+        emit(centre);
+        for k in 0..8u64 {
+            emit([0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * 2 * half));
+        }
+        if cand.len() > MAX_POINTS {
+            return Err(format!(
+                "more than {MAX_POINTS} interior points: the size is too small for the part"
+            ));
+        }
+    }
+    let mut near = Vec::new();
+    let mut keep = Vec::with_capacity(cand.len());
+    for p in cand {
+        let r = CLEARANCE * size.at(p);
+        let b = Aabb {
+            lo: p.map(|x| x - r),
+            hi: p.map(|x| x + r),
+        };
+        grid.query(&b, |_| true, &mut near);
+        let clear = near.iter().all(|&i| {
+            let q = tri_pts(&surf_tris[i as usize]);
+            point_triangle_dist2(p, q[0], q[1], q[2]) >= r * r
+        });
+        if clear {
+            keep.push(p);
+        }
+    }
+    Ok(keep)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::vec3::{det3, tet_det};
+    use crate::Options;
+    use std::collections::HashMap;
+
+    /// The whole fill of a P2 surface: every tet positive, the boundary exactly the
+    /// input's corner triangles, the volume the enclosed one, interior points added.
+    fn check_whole_fill(path: &str) -> FrontOutput {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let size = crate::generate::size_field(&s, &Options::default());
+        let out = whole_fill(s.nodes(), s.triangles(), &size).unwrap();
+        assert_eq!(&out.pts[..s.nodes().len()], s.nodes());
+        assert!(out.pts.len() > s.nodes().len(), "no interior point");
+        let mut vol = 0.0;
+        // Per oriented face: uses minus uses of its reverse.
+        let mut uses: HashMap<[u32; 3], i32> = HashMap::new();
+        let canon = |f: [u32; 3]| {
+            let r = (0..3).min_by_key(|&k| f[k]).unwrap();
+            [f[r], f[(r + 1) % 3], f[(r + 2) % 3]]
+        };
+        for t in &out.tets {
+            let p = t.map(|v| out.pts[v as usize]);
+            let d = tet_det(p[0], p[1], p[2], p[3]);
+            assert!(d > 0.0, "{t:?}");
+            vol += d / 6.0;
+            for g in super::super::validity::TET_OUT_FACES {
+                let f = g.map(|j| t[j]);
+                *uses.entry(canon(f)).or_insert(0) += 1;
+                *uses.entry(canon([f[0], f[2], f[1]])).or_insert(0) -= 1;
+            }
+        }
+        let mut bound: Vec<[u32; 3]> = uses
+            .iter()
+            .filter(|(_, &n)| n == 1)
+            .map(|(f, _)| *f)
+            .collect();
+        let mut want: Vec<[u32; 3]> = s
+            .triangles()
+            .iter()
+            .map(|t| canon([t[0], t[1], t[2]]))
+            .collect();
+        bound.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(bound, want, "the boundary is not the input's");
+        let enclosed: f64 = s
+            .triangles()
+            .iter()
+            .map(|t| {
+                det3(
+                    s.nodes()[t[0] as usize],
+                    s.nodes()[t[1] as usize],
+                    s.nodes()[t[2] as usize],
+                ) / 6.0
+            })
+            .sum();
+        assert!(
+            (vol - enclosed).abs() <= 1e-9 * enclosed,
+            "{vol} vs {enclosed}"
+        );
+        assert!(out.stats.whole_fill);
+        out
+    }
+
+    #[test]
+    fn the_whole_fill_keeps_the_boundary_and_fills_the_volume() {
+        let out = check_whole_fill("tests/data/sphere_p2.msh");
+        // The size field's spacing: the same order of tets as the front makes (2,499).
+        assert!(
+            (1_000..10_000).contains(&out.tets.len()),
+            "{}",
+            out.tets.len()
+        );
+        check_whole_fill("tests/data/screw_p2.msh");
+        check_whole_fill("tests/data/openscad/LetterBlock.stl");
+    }
+}
