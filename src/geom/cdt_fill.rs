@@ -395,7 +395,12 @@ impl<'a> Cdt<'a> {
                     let (proj, sign) =
                         projection_of(f[0], f[1], f[2]).ok_or("degenerate triangle")?;
                     let gp = g.map(|v| self.dt.p(v));
-                    if proj.orient2d(gp[0], gp[1], gp[2]) != -sign {
+                    // Or the tet's apex on the face's positive side: either test alone
+                    // can be turned by rounded Steiner points (a thin sub-face, an apex
+                    // nearly in the plane), a face that faces away fails both.
+                    let apex = tv.iter().find(|v| !g.contains(v)).map(|&v| self.dt.p(v));
+                    let above = apex.is_some_and(|d| orient3d(f[0], f[1], f[2], d) > 0);
+                    if proj.orient2d(gp[0], gp[1], gp[2]) != -sign && !above {
                         return Err("a surface triangle faces away from the region");
                     }
                 }
