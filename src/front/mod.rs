@@ -638,20 +638,18 @@ impl<'a> Mesher<'a> {
             // ...or, where the front is about to give up, by the constrained fill (it
             // closes what the search cannot; where local remeshing works, the remeshed
             // front makes better tets).
-            let comp = self.component(fid, constrained::MAX_FILL_FACES);
-            if let Some(c) = &comp {
-                if c.len() <= cavity::MAX_CAVITY_FACES && self.fill_cavity(c) {
+            if let Some(c) = self.component(fid, constrained::MAX_FILL_FACES) {
+                if c.len() <= cavity::MAX_CAVITY_FACES && self.fill_cavity(&c) {
                     self.stats.cavities += 1;
                     continue;
                 }
-            }
-            let giving_up = self.stats.repairs + 1 >= max_repairs
-                || self.stats.repairs + 1 - self.fewest_open.1 >= self.max_repairs_without_progress
-                || self.repair_count(fid) >= repair::MAX_REPAIRS_PER_REGION;
-            if let Some(c) = &comp {
+                let giving_up = self.stats.repairs + 1 >= max_repairs
+                    || self.stats.repairs + 1 - self.fewest_open.1
+                        >= self.max_repairs_without_progress
+                    || self.repair_count(fid) >= repair::MAX_REPAIRS_PER_REGION;
                 if self.use_fill && giving_up {
-                    let fixed = self.fixed_around(c);
-                    if self.constrained_fill(c, &fixed) {
+                    let fixed = self.fixed_around(&c);
+                    if self.constrained_fill(&c, &fixed) {
                         self.stats.constrained += 1;
                         continue;
                     }

@@ -1,8 +1,7 @@
-//! The whole region at once, for a surface the front cannot close within its work budget:
-//! interior points from the size field, then the constrained fill
-//! ([`crate::geom::cdt_fill`]) of the surface's triangles with those points. The boundary
-//! is kept exactly (added points are strictly inside), and the linear and high-order
-//! stages improve the tets like the front's.
+//! The whole region at once, for a surface no front attempt closes: interior points from
+//! the size field, then the constrained fill ([`crate::geom::cdt_fill`]) of the surface's
+//! triangles with those points. The boundary is kept exactly (added points are strictly
+//! inside), and the linear and high-order stages improve the tets like the front's.
 //!
 //! The points are the centres and corners of a graded octree's leaves: a body-centred
 //! cubic lattice wherever the size is uniform, whose Delaunay tets are all alike and well
@@ -101,6 +100,7 @@ fn interior_points(
         return Err("the surface has no extent".into());
     }
     let tri_pts = |t: &[u32; 6]| [0, 1, 2].map(|k| corner_pts[local(t[k]) as usize]);
+    // The grid's cell: twice the mean edge (one edge per triangle), as the front's.
     let mut mean_edge = 0.0;
     for t in surf_tris {
         let p = tri_pts(t);

@@ -650,8 +650,7 @@ impl Delaunay {
         };
         let on_face = |dt: &Delaunay, t: u32, j: usize| {
             let n = new_tet(dt, t, j);
-            !dt.positive(n) && orient3d(dt.p(n[0]), dt.p(n[1]), dt.p(n[2]), p) == 0
-                || dt.flat_by_construction(n)
+            orient3d(dt.p(n[0]), dt.p(n[1]), dt.p(n[2]), p) == 0 || dt.flat_by_construction(n)
         };
         let holds = |dt: &Delaunay, t: u32| {
             (0..4).all(|j| dt.positive(new_tet(dt, t, j)) || on_face(dt, t, j))
