@@ -7,14 +7,20 @@
 //! cubic lattice wherever the size is uniform, whose Delaunay tets are all alike and well
 //! shaped. A leaf is at most [`LEAF_PER_SIZE`] times the size at its centre; points
 //! nearer the surface than [`CLEARANCE`] times the size are dropped (the surface's own
-//! vertices are there), as are points outside (with the tets the fill discards).
+//! vertices are there), as are points outside (with the tets the fill discards) and
+//! points inside a surface edge's diametral ball or a triangle's equatorial ball: there
+//! they would keep the edge or triangle out of the Delaunay tetrahedralization and cost
+//! Steiner points on the surface (on CAD parts' long edges, hundreds).
+//!
+//! The fill places Steiner points at segment crossings; where that fails it is run
+//! again halving the segments ([`Split`]).
 
 use super::grid::{Aabb, FaceGrid};
 use super::size::SizeField;
 use super::{FrontOutput, FrontStats};
-use crate::geom::cdt_fill;
+use crate::geom::cdt_fill::{self, Split};
 use crate::geom::distance::point_triangle_dist2;
-use crate::geom::vec3::P3;
+use crate::geom::vec3::{axpy, cross, dist2, dot, mid, scale, sub, P3};
 use std::collections::HashSet;
 
 /// Largest leaf side, as a multiple of the size at its centre. The lattice's edges are
@@ -51,7 +57,11 @@ pub(crate) fn whole_fill(
         .iter()
         .map(|t| [local(t[0]), local(t[2]), local(t[1])])
         .collect();
-    let filled = cdt_fill::fill(&pts, &faces).map_err(|e| e.to_string())?;
+    // Steiner points at crossings first; halving where crossings pile up.
+    let filled = cdt_fill::fill(&pts, &faces, Split::AtCrossing).or_else(|first| {
+        cdt_fill::fill(&pts, &faces, Split::Halving)
+            .map_err(|second| format!("{first}; halving segments: {second}"))
+    })?;
     // Global ids: corners keep theirs; used interior and Steiner points follow the
     // surface nodes in order of first use.
     let mut out_pts = surf_nodes.to_vec();
@@ -108,8 +118,18 @@ fn interior_points(
     }
     mean_edge /= surf_tris.len().max(1) as f64;
     let mut grid = FaceGrid::new(bounds, 2.0 * mean_edge, (16 * surf_tris.len()).max(1 << 16));
+    let balls: Vec<Vec<(P3, f64)>> = surf_tris
+        .iter()
+        .map(|t| protecting_balls(tri_pts(t)))
+        .collect();
     for (i, t) in surf_tris.iter().enumerate() {
-        grid.insert(i as u32, &Aabb::of(&tri_pts(t)));
+        let mut b = Aabb::of(&tri_pts(t));
+        for &(c, r2) in &balls[i] {
+            let r = r2.sqrt();
+            b.lo = std::array::from_fn(|d| b.lo[d].min(c[d] - r));
+            b.hi = std::array::from_fn(|d| b.hi[d].max(c[d] + r));
+        }
+        grid.insert(i as u32, &b);
     }
     // Integer coordinates in units of the root side / 2^(MAX_DEPTH + 1): every leaf's
     // corners and centre are whole, so shared points are found exactly.
@@ -157,12 +177,43 @@ fn interior_points(
         let clear = near.iter().all(|&i| {
             let q = tri_pts(&surf_tris[i as usize]);
             point_triangle_dist2(p, q[0], q[1], q[2]) >= r * r
+                && balls[i as usize].iter().all(|&(c, r2)| dist2(p, c) >= r2)
         });
         if clear {
             keep.push(p);
         }
     }
     Ok(keep)
+}
+
+/// The balls an interior point must stay out of for a surface triangle's edges and the
+/// triangle itself to be Delaunay faces among the surface's points and it: each edge's
+/// diametral ball, and the triangle's equatorial ball (centre its circumcentre) unless
+/// the triangle is so obtuse that the ball reaches past its longest edge. As (centre,
+/// squared radius).
+fn protecting_balls(q: [P3; 3]) -> Vec<(P3, f64)> {
+    let mut out: Vec<(P3, f64)> = (0..3)
+        .map(|k| {
+            let (a, b) = (q[k], q[(k + 1) % 3]);
+            (mid(a, b), 0.25 * dist2(a, b))
+        })
+        .collect();
+    let (u, v) = (sub(q[1], q[0]), sub(q[2], q[0]));
+    let n = cross(u, v);
+    let nn = dot(n, n);
+    if nn > 0.0 {
+        // Circumcentre: q0 + ((|u|² v - |v|² u) x n) / (2 |n|²).
+        let w = sub(scale(v, dot(u, u)), scale(u, dot(v, v)));
+        let c = axpy(q[0], 0.5 / nn, cross(w, n));
+        let r2 = dist2(c, q[0]);
+        let longest2 = (0..3)
+            .map(|k| dist2(q[k], q[(k + 1) % 3]))
+            .fold(0.0, f64::max);
+        if r2 <= longest2 {
+            out.push((c, r2));
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -245,5 +296,10 @@ mod tests {
         // orientation alone misjudges the side the region is on.
         check_whole_fill("tests/data/hinge_p2.msh");
         check_whole_fill("tests/data/openscad/LetterBlock.stl");
+        // Long edges between coplanar points: without the protecting balls, interior
+        // points near them leave 900 Steiner points on 328 vertices, some stuck.
+        check_whole_fill("tests/data/openscad/offset.stl");
+        // Crossings next to nearly flat tets: recovered by halving the segments.
+        check_whole_fill("tests/data/openscad/example007.stl");
     }
 }

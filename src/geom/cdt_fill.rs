@@ -35,8 +35,8 @@ pub(crate) struct Filled {
 /// boundary faces are exactly `faces`; new points are strictly inside. Err names the
 /// stage that could not go on (a degenerate or self-intersecting surface, or a rounded
 /// Steiner point that would invert a tet).
-pub(crate) fn fill(pts: &[P3], faces: &[[u32; 3]]) -> Result<Filled, &'static str> {
-    let mut c = Cdt::new(pts, faces)?;
+pub(crate) fn fill(pts: &[P3], faces: &[[u32; 3]], split: Split) -> Result<Filled, &'static str> {
+    let mut c = Cdt::new(pts, faces, split)?;
     c.recover_edges()?;
     for i in 0..faces.len() {
         c.recover_face(i)?;
@@ -44,6 +44,18 @@ pub(crate) fn fill(pts: &[P3], faces: &[[u32; 3]]) -> Result<Filled, &'static st
     c.keep_enclosed()?;
     c.remove_steiner_points()?;
     c.result()
+}
+
+/// Where edge recovery puts a Steiner point when flips cannot bring a segment piece in.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub(crate) enum Split {
+    /// Where the piece leaves the tet at its current end: one point per crossed face at
+    /// most, but a rounded point on a face (the other ways follow where that inverts a
+    /// tet).
+    AtCrossing,
+    /// Halfway along the piece first, by Bowyer-Watson: points off the faces, where
+    /// crossings pile up next to nearly flat tets (a second try on CAD parts).
+    Halving,
 }
 
 /// Flips tried per segment or face to clear nearly flat tets out of a split's way.
@@ -61,10 +73,11 @@ struct Cdt<'a> {
     inner: Vec<Vec<u32>>,
     /// Sorted constraint sub-face -> its input face.
     parent: HashMap<[u32; 3], usize>,
+    split: Split,
 }
 
 impl<'a> Cdt<'a> {
-    fn new(pts: &[P3], faces: &'a [[u32; 3]]) -> Result<Cdt<'a>, &'static str> {
+    fn new(pts: &[P3], faces: &'a [[u32; 3]], split: Split) -> Result<Cdt<'a>, &'static str> {
         let dt = Delaunay::new(pts);
         let n = pts.len();
         if faces.iter().flatten().any(|&v| v as usize >= n) {
@@ -89,6 +102,7 @@ impl<'a> Cdt<'a> {
             chains: HashMap::new(),
             inner: vec![Vec::new(); faces.len()],
             parent: HashMap::new(),
+            split,
         })
     }
 
@@ -136,10 +150,21 @@ impl<'a> Cdt<'a> {
                 goals.pop();
                 continue;
             }
-            let (t, k) = self
-                .dt
-                .leaving(cur, goal)
-                .ok_or("no tet leaves a segment's end toward its other end")?;
+            if self.split == Split::Halving {
+                if let Some(s) = self.insert_between(a, b, cur, goal) {
+                    goals.push(s);
+                    continue;
+                }
+            }
+            let Some((t, k)) = self.dt.leaving(cur, goal) else {
+                // Rounded Steiner points can leave no tet that the straight piece
+                // leaves cur through: a point between them on the segment instead.
+                let s = self
+                    .insert_between(a, b, cur, goal)
+                    .ok_or("no tet leaves a segment's end toward its other end")?;
+                goals.push(s);
+                continue;
+            };
             let tv = self.dt.tets[t as usize];
             let f = FACES[k].map(|j| tv[j]);
             let fp = f.map(|v| self.dt.p(v));
@@ -193,7 +218,10 @@ impl<'a> Cdt<'a> {
                         Some(s) => s,
                         None => {
                             self.dt.on_line.remove(&next);
-                            return Err("a Steiner point on a surface edge would invert a tet");
+                            // ...else a point between cur and goal, away from the face
+                            // whose crossing is too near other points.
+                            self.insert_between(a, b, cur, goal)
+                                .ok_or("a Steiner point on a surface edge would invert a tet")?
                         }
                     }
                 }
@@ -207,6 +235,31 @@ impl<'a> Cdt<'a> {
             }
         }
         Err("edge recovery did not end")
+    }
+
+    /// Insert a point of input edge ab strictly between its points `cur` and `goal`
+    /// (halfway, else a quarter from either), by Bowyer-Watson: a point off every face
+    /// it is rounded near, where a split at the segment's crossing would invert a tet.
+    fn insert_between(&mut self, a: u32, b: u32, cur: u32, goal: u32) -> Option<u32> {
+        let (pa, pb) = (self.dt.p(a), self.dt.p(b));
+        let ab = sub(pb, pa);
+        let len2 = dot(ab, ab);
+        let param = |v: u32| dot(sub(self.dt.p(v), pa), ab) / len2;
+        let (t0, t1) = (param(cur), param(goal));
+        for f in [0.5, 0.25, 0.75] {
+            let t = t0 + f * (t1 - t0);
+            let p = axpy(pa, t, ab);
+            if !(t > t0.min(t1) && t < t0.max(t1)) || p == self.dt.p(cur) || p == self.dt.p(goal) {
+                continue;
+            }
+            let next = self.dt.next_id();
+            self.dt.on_line.insert(next, sorted2(a, b));
+            if let Some(s) = self.dt.insert_point(p) {
+                return Some(s);
+            }
+            self.dt.on_line.remove(&next);
+        }
+        None
     }
 
     /// The chain of input edge (a, b), from a to b.
@@ -489,7 +542,8 @@ impl<'a> Cdt<'a> {
                 star
             };
             if star.is_empty() {
-                return Ok(0);
+                // Every pocket tried: those that failed are left for the next round.
+                return Ok(if self.dt.star(s).is_empty() { 0 } else { left });
             }
             let mut comp = self.component(s, &star);
             let mut moved = None;
@@ -946,7 +1000,7 @@ mod tests {
     /// boundary exactly the input, volume the enclosed one.
     fn fill_and_check(pts: &[P3], outward: &[[u32; 3]]) -> Result<Filled, String> {
         let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
-        let r = fill(pts, &faces).map_err(|e| e.to_string())?;
+        let r = fill(pts, &faces, Split::AtCrossing).map_err(|e| e.to_string())?;
         assert_eq!(&r.pts[..pts.len()], pts);
         let mut vol = 0.0;
         let mut uses: HashMap<[u32; 3], i32> = HashMap::new();
