@@ -174,7 +174,10 @@ fn generate_inner(
                 front.tets,
                 Some(&front.quality),
                 &bnd,
-                &LinearParams::default(),
+                &LinearParams {
+                    guard_slivers: front.stats.whole_fill,
+                    ..LinearParams::default()
+                },
             );
             ostats.linear = st;
             ostats.time_linear = t.elapsed().as_secs_f64();

@@ -22,7 +22,7 @@ impl Mesher<'_> {
             .iter()
             .map(|&f| self.faces[f as usize].v.map(local))
             .collect();
-        let Ok(filled) = cdt_fill::fill(&pts, &faces, cdt_fill::Split::AtCrossing) else {
+        let Ok(filled) = cdt_fill::fill(&pts, &faces, cdt_fill::Split::AtCrossing, None) else {
             return false;
         };
         // Global ids: the cavity's vertices, then the new points (not yet added).

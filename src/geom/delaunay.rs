@@ -66,7 +66,7 @@ pub(crate) struct Delaunay {
     pub fixed_edges: HashSet<[u32; 2]>,
     /// Faces (sorted ids) that no flip may remove: recovered constraint faces.
     pub fixed_faces: HashSet<[u32; 3]>,
-    last: u32,
+    pub(crate) last: u32,
 }
 
 impl Delaunay {
@@ -138,7 +138,7 @@ impl Delaunay {
     }
 
     /// The tet containing point `q` (closed), by a visibility walk from the last tet made.
-    fn locate(&self, q: P3) -> u32 {
+    pub(crate) fn locate(&self, q: P3) -> u32 {
         let mut t = self.last;
         if !self.alive[t as usize] {
             t = self.alive.iter().position(|&a| a).unwrap_or(0) as u32;

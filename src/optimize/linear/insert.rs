@@ -7,7 +7,9 @@
 use super::mesh::{opposite_edge, LinMesh};
 use super::objective::{cut_bound, ruled_out};
 use super::smooth::{smooth_vertex, SmoothParams, SmoothScratch};
+use crate::geom::tet_quality::dihedral_extremes;
 use crate::geom::vec3::mid;
+use crate::mesh::slivers::SLIVER_DEG;
 
 /// Scratch buffers of the insertion.
 #[derive(Default)]
@@ -19,6 +21,9 @@ pub(super) struct InsertScratch {
     /// Qualities of the new tets, two per old tet.
     new_q: Vec<f64>,
     added: Vec<u32>,
+    /// Refuse a split that makes more slivers than it removes (set in the passes aimed at
+    /// the worst tets only, see [`super::LinearParams::reach`]).
+    pub sliver_guard: bool,
 }
 
 /// Try splitting the interior edge (a, b); true when kept.
@@ -95,7 +100,23 @@ pub(super) fn split_edge(
         .iter()
         .map(|&t| m.q[t as usize])
         .fold(f64::INFINITY, f64::min);
-    if new_min > old_min + eps {
+    // Where the goal is out of reach (tets the boundary forces to be poor), a split that
+    // lifts the minimum by making more slivers than it removes only moves the problem
+    // (the passes made thousands of interior slivers this way); with the guard on it is
+    // kept only where it makes a tet valid.
+    let slivers = |tets: &mut dyn Iterator<Item = [u32; 4]>, pts: &[crate::geom::vec3::P3]| {
+        tets.filter(|t| dihedral_extremes(&t.map(|v| pts[v as usize])).0 < SLIVER_DEG)
+            .count()
+    };
+    let more_slivers = || {
+        let before = slivers(&mut s.old.iter().copied(), &m.pts);
+        let after = slivers(
+            &mut m.vt[np as usize].iter().map(|&t| m.tets[t as usize]),
+            &m.pts,
+        );
+        after > before
+    };
+    if new_min > old_min + eps && (!s.sliver_guard || old_min < 0.0 || !more_slivers()) {
         return true;
     }
     // Undo: the new vertex stays as an unused point.
