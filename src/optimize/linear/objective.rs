@@ -2,7 +2,7 @@
 //! operation touches): 1 − equiangular skewness (paper eq. 2) of the corner tet, in
 //! [0, 1], for a tet that is positive (exact) and, when it touches a curved boundary edge,
 //! certified valid as a P2 element. A positive tet that is not P2-valid scores in
-//! [−1, −0.5] by its scaled-Jacobian lower bound (so operations may improve it but never
+//! [−1, −0.5] by how far its Jacobian bound is from positive (so operations may improve it but never
 //! create one); a non-positive tet, or one no placement of its interior mid nodes can make
 //! valid, scores −∞.
 
@@ -90,13 +90,15 @@ impl ElementQuality {
                 if !fixed_coefficients_positive(&b, tau, free_mid()) {
                     return f64::NEG_INFINITY;
                 }
-                let sj = jacobian_bounds(&x, 1e-2).scaled_lower();
-                let sj = if sj.is_nan() {
-                    -1.0
-                } else {
-                    sj.clamp(-1.0, 0.0)
-                };
-                return -1.0 + 0.5 * (1.0 + sj);
+                // How far det J is from positive, in (-1, 0]: min_lower over |min_lower| +
+                // |max_upper|, which keeps falling as the element gets more inverted (the
+                // scaled Jacobian's bound is -1 for every fully inverted element, a
+                // plateau on which no operation could show progress: on OpenSCAD's
+                // example021 the whole fill left such tets that the passes never moved).
+                let jb = jacobian_bounds(&x, 1e-2);
+                let r = jb.min_lower / (jb.min_lower.abs() + jb.max_upper.abs());
+                let r = if r.is_nan() { -1.0 } else { r.clamp(-1.0, 0.0) };
+                return -1.0 + 0.5 * (1.0 + r);
             }
             let ratio = blo / bhi;
             if nb == 4 {
