@@ -717,10 +717,28 @@ impl<'a> Cdt<'a> {
                 [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
             })
             .collect();
+        // Whether every new tet is positive, testing first the one that failed last: a
+        // step along a direction mostly fails on the same tet, so most candidates cost
+        // one orientation test instead of one per tet (on OpenSCAD's example012 these
+        // tests were three quarters of the whole run). The answer does not depend on the
+        // order.
+        let mut last_bad = 0;
+        let mut all_positive = |dt: &Delaunay| {
+            if !dt.positive(tets[last_bad]) {
+                return false;
+            }
+            match tets.iter().position(|&t| !dt.positive(t)) {
+                Some(i) => {
+                    last_bad = i;
+                    false
+                }
+                None => true,
+            }
+        };
         let mut placed = false;
         if let Some(c) = kernel_centre(&walls, ps) {
             self.dt.pts[q as usize] = c;
-            placed = tets.iter().all(|&t| self.dt.positive(t));
+            placed = all_positive(&self.dt);
         }
         'dirs: for d in dirs {
             if placed {
@@ -733,7 +751,7 @@ impl<'a> Cdt<'a> {
             for k in 1..60 {
                 let p = axpy(ps, reach * 0.5f64.powi(k) / l, d);
                 self.dt.pts[q as usize] = p;
-                if tets.iter().all(|&t| self.dt.positive(t)) {
+                if all_positive(&self.dt) {
                     placed = true;
                     break 'dirs;
                 }
