@@ -57,9 +57,9 @@ pub(crate) fn whole_fill(
         .iter()
         .map(|t| [local(t[0]), local(t[2]), local(t[1])])
         .collect();
-    // Steiner points at crossings first; halving where crossings pile up.
     // Thin tets on the surface get a point above it, at most a size high.
     let height = |p: P3| size.at(p);
+    // Steiner points at crossings first; halving where crossings pile up.
     let filled =
         cdt_fill::fill(&pts, &faces, Split::AtCrossing, Some(&height)).or_else(|first| {
             cdt_fill::fill(&pts, &faces, Split::Halving, Some(&height))
@@ -309,7 +309,7 @@ mod tests {
     /// The linear stage on a whole fill with and without `guard_slivers`: the tets with a
     /// dihedral angle below 10° and no corner on the surface (never forced by it).
     fn interior_slivers_after_linear(path: &str, guard: bool) -> usize {
-        use crate::geom::tet_quality::dihedral_extremes;
+        use crate::mesh::slivers::is_sliver;
         use crate::optimize::linear::{improve_linear, LinearParams};
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
@@ -323,9 +323,7 @@ mod tests {
         let (pts, tets, _) = improve_linear(out.pts, out.tets, &bnd, &prm);
         tets.iter()
             .filter(|t| {
-                t.iter().all(|&v| !bnd.is_fixed(v))
-                    && dihedral_extremes(&t.map(|v| pts[v as usize])).0
-                        < crate::mesh::slivers::SLIVER_DEG
+                t.iter().all(|&v| !bnd.is_fixed(v)) && is_sliver(&t.map(|v| pts[v as usize]))
             })
             .count()
     }

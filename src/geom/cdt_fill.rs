@@ -818,17 +818,19 @@ impl<'a> Cdt<'a> {
                         continue;
                     }
                     let f = fk.map(|j| self.dt.p(tv[j]));
-                    let d = self.dt.p(tv[k]);
                     let n = tri_normal(f[0], f[1], f[2]);
                     let nn = norm(n);
-                    let mean = (dist(f[0], f[1]) + dist(f[1], f[2]) + dist(f[2], f[0])) / 3.0;
                     if nn.is_nan() || nn <= 0.0 {
                         continue;
                     }
-                    let n = [n[0] / nn, n[1] / nn, n[2] / nn];
-                    let hd = dot(n, sub(d, f[0]));
+                    let n = n.map(|x| x / nn);
                     // Inward: the side the apex is on (the tet is positive).
-                    let inward = if hd > 0.0 { 1.0 } else { -1.0 };
+                    let inward = if dot(n, sub(self.dt.p(tv[k]), f[0])) > 0.0 {
+                        1.0
+                    } else {
+                        -1.0
+                    };
+                    let mean = (dist(f[0], f[1]) + dist(f[1], f[2]) + dist(f[2], f[0])) / 3.0;
                     let c = [0, 1, 2].map(|i| (f[0][i] + f[1][i] + f[2][i]) / 3.0);
                     // An equilateral tet's height: sqrt(2/3) of its edge.
                     let h = (0.8165 * mean).min(height(c));
@@ -844,8 +846,7 @@ impl<'a> Cdt<'a> {
                     continue;
                 }
                 // The walk starts at the tet on the face, which p is above.
-                self.dt.last = t;
-                let s = self.dt.locate(p);
+                let s = self.dt.locate_from(t, p);
                 let sv = self.dt.tets[s as usize];
                 let inside = self.dt.alive[s as usize]
                     && FACES.iter().enumerate().all(|(k, fk)| {
@@ -854,7 +855,7 @@ impl<'a> Cdt<'a> {
                         o < 0 || (o == 0 && self.dt.adj[s as usize][k] != NONE)
                     });
                 let crowded = sv.iter().any(|&v| dist(self.dt.p(v), p) < 0.3 * h);
-                if inside && !crowded && self.dt.insert_point(p).is_some() {
+                if inside && !crowded && self.dt.insert_point_in(s, p).is_some() {
                     added += 1;
                 }
             }

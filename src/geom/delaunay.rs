@@ -66,7 +66,7 @@ pub(crate) struct Delaunay {
     pub fixed_edges: HashSet<[u32; 2]>,
     /// Faces (sorted ids) that no flip may remove: recovered constraint faces.
     pub fixed_faces: HashSet<[u32; 3]>,
-    pub(crate) last: u32,
+    last: u32,
 }
 
 impl Delaunay {
@@ -138,8 +138,14 @@ impl Delaunay {
     }
 
     /// The tet containing point `q` (closed), by a visibility walk from the last tet made.
-    pub(crate) fn locate(&self, q: P3) -> u32 {
-        let mut t = self.last;
+    fn locate(&self, q: P3) -> u32 {
+        self.locate_from(self.last, q)
+    }
+
+    /// [`Delaunay::locate`] walking from tet `start` (in a region that is not convex, the
+    /// walk can stop at the boundary: start near `q`).
+    pub(crate) fn locate_from(&self, start: u32, q: P3) -> u32 {
+        let mut t = start;
         if !self.alive[t as usize] {
             t = self.alive.iter().position(|&a| a).unwrap_or(0) as u32;
         }
@@ -630,7 +636,11 @@ impl Delaunay {
     /// if the tets holding `p` themselves are in the way, or a new tet would be one
     /// [`Delaunay::valid_new`] refuses.
     pub(crate) fn insert_point(&mut self, p: P3) -> Option<u32> {
-        let start = self.locate(p);
+        self.insert_point_in(self.locate(p), p)
+    }
+
+    /// [`Delaunay::insert_point`] where tet `start` holds `p`.
+    pub(crate) fn insert_point_in(&mut self, start: u32, p: P3) -> Option<u32> {
         let tv = self.tets[start as usize];
         if !self.alive[start as usize] || tv.iter().any(|&v| self.p(v) == p) {
             return None;

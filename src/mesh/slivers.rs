@@ -31,6 +31,11 @@ pub struct SliverCensus {
     pub worst_forcing_triangle: Option<(usize, f64)>,
 }
 
+/// Whether the tet on corners `c` is a sliver: a dihedral angle below [`SLIVER_DEG`].
+pub fn is_sliver(c: &[P3; 4]) -> bool {
+    dihedral_extremes(c).0 < SLIVER_DEG
+}
+
 /// The smallest angle of the triangle on corners `p`, degrees.
 pub fn smallest_angle_deg(p: [P3; 3]) -> f64 {
     let mut best = f64::INFINITY;
@@ -60,10 +65,10 @@ pub fn census(m: &TetMesh) -> SliverCensus {
     let mut c = SliverCensus::default();
     for t in &m.tets {
         let p = [t[0], t[1], t[2], t[3]].map(|v| m.nodes[v as usize]);
-        let (mn, _) = dihedral_extremes(&p);
-        if mn.is_nan() || mn >= SLIVER_DEG {
+        if !is_sliver(&p) {
             continue;
         }
+        let (mn, _) = dihedral_extremes(&p);
         let (theta, tri) =
             t[..4]
                 .iter()

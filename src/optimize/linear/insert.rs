@@ -7,9 +7,8 @@
 use super::mesh::{opposite_edge, LinMesh};
 use super::objective::{cut_bound, ruled_out};
 use super::smooth::{smooth_vertex, SmoothParams, SmoothScratch};
-use crate::geom::tet_quality::dihedral_extremes;
 use crate::geom::vec3::mid;
-use crate::mesh::slivers::SLIVER_DEG;
+use crate::mesh::slivers::is_sliver;
 
 /// Scratch buffers of the insertion.
 #[derive(Default)]
@@ -21,8 +20,8 @@ pub(super) struct InsertScratch {
     /// Qualities of the new tets, two per old tet.
     new_q: Vec<f64>,
     added: Vec<u32>,
-    /// Refuse a split that makes more slivers than it removes (set in the passes aimed at
-    /// the worst tets only, see [`super::LinearParams::reach`]).
+    /// Refuse a split that makes more slivers than it removes (see
+    /// [`super::LinearParams::guard_slivers`]; set per pass).
     pub sliver_guard: bool,
 }
 
@@ -104,17 +103,12 @@ pub(super) fn split_edge(
     // lifts the minimum by making more slivers than it removes only moves the problem
     // (the passes made thousands of interior slivers this way); with the guard on it is
     // kept only where it makes a tet valid.
-    let slivers = |tets: &mut dyn Iterator<Item = [u32; 4]>, pts: &[crate::geom::vec3::P3]| {
-        tets.filter(|t| dihedral_extremes(&t.map(|v| pts[v as usize])).0 < SLIVER_DEG)
-            .count()
-    };
+    let sliver = |t: &[u32; 4]| is_sliver(&t.map(|v| m.pts[v as usize]));
     let more_slivers = || {
-        let before = slivers(&mut s.old.iter().copied(), &m.pts);
-        let after = slivers(
-            &mut m.vt[np as usize].iter().map(|&t| m.tets[t as usize]),
-            &m.pts,
-        );
-        after > before
+        let after = m.vt[np as usize]
+            .iter()
+            .filter(|&&t| sliver(&m.tets[t as usize]));
+        after.count() > s.old.iter().filter(|t| sliver(t)).count()
     };
     if new_min > old_min + eps && (!s.sliver_guard || old_min < 0.0 || !more_slivers()) {
         return true;

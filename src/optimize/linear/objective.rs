@@ -2,9 +2,9 @@
 //! operation touches): 1 − equiangular skewness (paper eq. 2) of the corner tet, in
 //! [0, 1], for a tet that is positive (exact) and, when it touches a curved boundary edge,
 //! certified valid as a P2 element. A positive tet that is not P2-valid scores in
-//! [−1, −0.5] by how far its Jacobian bound is from positive (so operations may improve it but never
-//! create one); a non-positive tet, or one no placement of its interior mid nodes can make
-//! valid, scores −∞.
+//! [−1, −0.5] by how far its Jacobian bound is from positive (so operations may improve
+//! it but never create one); a non-positive tet, or one no placement of its interior mid
+//! nodes can make valid, scores −∞.
 
 use super::mesh::opposite_edge;
 use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds, LinearJacobian};
