@@ -233,6 +233,44 @@ fn size_from_is_an_option_and_in_the_report() {
     );
 }
 
+/// `--gradation` is taken and reported: a faster growth inward gives the screw fewer tets;
+/// 0 is refused with the option's name, and a uniform size does not combine with it.
+#[test]
+fn gradation_is_an_option_and_in_the_report() {
+    let screw = data("screw_p2.msh");
+    let slow = mesh_report(&screw, "screw_g02", &["--no-optimize"]);
+    let fast = mesh_report(
+        &screw,
+        "screw_g08",
+        &["--no-optimize", "--gradation", "0.8"],
+    );
+    assert_eq!(slow["options"]["gradation"], 0.2);
+    assert_eq!(fast["options"]["gradation"], 0.8);
+    let tets = |r: &serde_json::Value| r["report"]["num_tets"].as_u64().unwrap();
+    assert!(
+        tets(&fast) < tets(&slow),
+        "{} vs {}",
+        tets(&fast),
+        tets(&slow)
+    );
+    let out_path = tmp("g.msh");
+    let run_with = |extra: &[&str]| {
+        let mut args = vec![
+            "mesh",
+            screw.to_str().unwrap(),
+            "-o",
+            out_path.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        run(&args)
+    };
+    let zero = run_with(&["--gradation", "0"]);
+    assert_eq!(zero.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&zero.stderr).contains("gradation must be"));
+    let both = run_with(&["--gradation", "0.5", "--size", "1"]);
+    assert_eq!(both.status.code(), Some(1), "clap refuses the combination");
+}
+
 /// A uniform `--size` far above the boundary's edges (the unit sphere's mean edge is about
 /// 0.2) is clamped to twice the mean edge, with a warning, and the report gives the size
 /// used; a size below that is used as given.

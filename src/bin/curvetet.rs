@@ -226,6 +226,10 @@ struct MeshOptions {
     /// most triangles are elongated, else edges (auto)
     #[arg(long, value_enum, default_value_t = SizeFromArg::Auto, conflicts_with_all = ["size", "uniform_size"])]
     size_from: SizeFromArg,
+    /// Growth rate of the graded size: sizes grow by at most this fraction of the
+    /// distance from the boundary (larger: fewer tets inside; smaller: a smoother field)
+    #[arg(long, default_value_t = Options::default().gradation, conflicts_with_all = ["size", "uniform_size"])]
+    gradation: f64,
     /// Skip quality improvement and high-order optimization.
     #[arg(long)]
     no_optimize: bool,
@@ -300,6 +304,7 @@ impl MeshOptions {
                 SizeFromArg::Edges => SizeFrom::Edges,
                 SizeFromArg::Areas => SizeFrom::Areas,
             })
+            .with_gradation(self.gradation)
             .with_optimize(!self.no_optimize)
             .with_thorough(self.thorough)
             .with_threads(self.threads)
