@@ -13,7 +13,10 @@
 //! 5. Every Steiner point is then moved off the surface (TetGen's `-Y`): its star's
 //!    constraint faces are retriangulated without it (a best-shaped triangulation in
 //!    the triangle's plane, exact 2D orientations) and it is placed along the inward normal where every
-//!    tet of its new star is positive. The surface triangles come back exactly.
+//!    tet of its new star is positive. Where no point is (a nearly flat tet of the star
+//!    at the point: every inward step inverts it), the star grows through the faces a
+//!    point just inside does not see, until it sees them all ([`Cdt::grown_star`]). The
+//!    surface triangles come back exactly.
 //!
 //! Every topological decision is an exact orient3d/orient2d; the Steiner coordinates are
 //! rounded, which the final checks cover: the boundary faces must be the input triangles
@@ -29,6 +32,10 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 pub(crate) struct Filled {
     pub pts: Vec<P3>,
     pub tets: Vec<[u32; 4]>,
+    /// Steiner points moved off the surface with a grown cavity ([`Cdt::grown_star`]);
+    /// the tests show that path runs by it.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub grown: usize,
 }
 
 /// Tetrahedralize the region bounded by `faces` (indices into `pts`, each oriented with the
@@ -80,6 +87,12 @@ pub(crate) enum Split {
 /// Flips tried per segment or face to clear nearly flat tets out of a split's way.
 const MAX_UNBLOCK: usize = 64;
 
+/// Most tets a Steiner point's cavity grows to ([`Cdt::grown_star`]).
+const GROW_LIMIT: usize = 400;
+
+/// Step lengths tried for a grown cavity's point: `reach / 2^k` for k in 2..this.
+const GROW_STEPS: i32 = 40;
+
 /// Rounds over the Steiner points not yet moved off the surface.
 const MOVE_ROUNDS: usize = 4;
 
@@ -93,6 +106,8 @@ struct Cdt<'a> {
     /// Sorted constraint sub-face -> its input face.
     parent: HashMap<[u32; 3], usize>,
     split: Split,
+    /// Steiner points moved off with a grown cavity.
+    grown: usize,
 }
 
 impl<'a> Cdt<'a> {
@@ -122,6 +137,7 @@ impl<'a> Cdt<'a> {
             inner: vec![Vec::new(); faces.len()],
             parent: HashMap::new(),
             split,
+            grown: 0,
         })
     }
 
@@ -776,11 +792,42 @@ impl<'a> Cdt<'a> {
                 usize::MAX
             }));
         }
+        let mut cavity = comp.to_vec();
+        if !placed && !unblock {
+            // No point sees the star itself (a tet of it is nearly flat at `s`, so every
+            // inward step crosses its far face): a larger cavity that some point near
+            // `s` sees.
+            let faces: Vec<[u32; 4]> = tets[link.len()..].to_vec();
+            // The smallest such cavity over the candidate points.
+            let mut best: Option<(P3, Vec<u32>, Vec<[u32; 4]>)> = None;
+            for d in [inward, centre] {
+                let l = norm(d);
+                if l.is_nan() || l <= 0.0 || !reach.is_finite() {
+                    continue;
+                }
+                for k in 2..GROW_STEPS {
+                    let p = axpy(ps, reach * 0.5f64.powi(k) / l, d);
+                    self.dt.pts[q as usize] = p;
+                    if let Some((cav, new)) = self.grown_star(s, q, comp, &faces) {
+                        if best.as_ref().map_or(true, |b| cav.len() < b.1.len()) {
+                            best = Some((p, cav, new));
+                        }
+                    }
+                }
+            }
+            if let Some((p, cav, new)) = best {
+                self.dt.pts[q as usize] = p;
+                cavity = cav;
+                tets = new;
+                placed = true;
+                self.grown += 1;
+            }
+        }
         if !placed {
             self.dt.pop_point();
             return Ok(None);
         }
-        self.dt.replace(comp, &tets);
+        self.dt.replace(&cavity, &tets);
         for (g, i) in new_faces {
             for k in 0..3 {
                 self.dt.fixed_edges.insert(sorted2(g[k], g[(k + 1) % 3]));
@@ -789,6 +836,95 @@ impl<'a> Cdt<'a> {
             self.parent.insert(sorted3(g), i);
         }
         Ok(Some(groups.len()))
+    }
+
+    /// The cavity that the new point `q` (at its current position) sees, grown from the
+    /// tets `comp` around Steiner point `s`, and the tets joining `q` to its faces and to
+    /// the retriangulated surface faces `faces` (as tets with `q`). Each cavity face `q`
+    /// does not see strictly (positively) is crossed into the tet behind it, Bowyer-Watson
+    /// fashion, until `q` sees them all: the cavity is then star-shaped from `q`, so the
+    /// new tets fill it. None where the face to cross is a surface face, the tet behind it
+    /// has `s` (another pocket), the cavity passes [`GROW_LIMIT`] tets, a vertex would be
+    /// left in no tet, or `q` is not strictly inside `faces`.
+    fn grown_star(
+        &self,
+        s: u32,
+        q: u32,
+        comp: &[u32],
+        faces: &[[u32; 4]],
+    ) -> Option<(Vec<u32>, Vec<[u32; 4]>)> {
+        if !faces.iter().all(|&t| self.dt.positive(t)) {
+            return None;
+        }
+        let mut cavity: Vec<u32> = comp.to_vec();
+        let mut inside: HashSet<u32> = cavity.iter().copied().collect();
+        // The faces at `s` are inside the star or are the surface faces `faces` replace.
+        let at_s = |tv: [u32; 4], k: usize| tv[k] != s && tv.contains(&s);
+        // Each face is tested when its tet joins; a face seen stays seen, or becomes
+        // inner when the tet behind it joins later.
+        let mut todo: Vec<(u32, usize)> = cavity
+            .iter()
+            .flat_map(|&t| (0..4).map(move |k| (t, k)))
+            .collect();
+        while let Some((t, k)) = todo.pop() {
+            let tv = self.dt.tets[t as usize];
+            let nb = self.dt.adj[t as usize][k];
+            if at_s(tv, k) || (nb != NONE && inside.contains(&nb)) {
+                continue;
+            }
+            let mut nt = tv;
+            nt[k] = q;
+            if self.dt.positive(nt) {
+                continue;
+            }
+            if nb == NONE || self.dt.tets[nb as usize].contains(&s) {
+                return None;
+            }
+            inside.insert(nb);
+            cavity.push(nb);
+            if cavity.len() > GROW_LIMIT {
+                return None;
+            }
+            todo.extend((0..4).map(|k| (nb, k)));
+        }
+        let mut new = Vec::new();
+        for &t in &cavity {
+            let tv = self.dt.tets[t as usize];
+            for k in 0..4 {
+                let nb = self.dt.adj[t as usize][k];
+                if !at_s(tv, k) && (nb == NONE || !inside.contains(&nb)) {
+                    let mut nt = tv;
+                    nt[k] = q;
+                    new.push(nt);
+                }
+            }
+        }
+        // Interior points the cavity swallows are left out (in no tet; the result keeps
+        // only the points tets use): every surface point has a surface face, which stays
+        // a cavity face.
+        new.extend_from_slice(faces);
+        // The new tets tile the cavity when its boundary is a closed surface (every edge
+        // on two faces, once each way) and they take its volume (a boundary pinched at a
+        // vertex can wind twice around `q`).
+        let mut edges: HashMap<[u32; 2], i32> = HashMap::new();
+        for t in &new {
+            let j = t.iter().position(|&v| v == q).unwrap_or(3);
+            let f = FACES[j].map(|m| t[m]);
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                *edges.entry(sorted2(a, b)).or_insert(0) += if a < b { 1 } else { -1 };
+            }
+        }
+        let vol = |t: &[u32; 4]| {
+            let p = t.map(|v| self.dt.p(v));
+            tet_det(p[0], p[1], p[2], p[3]).abs()
+        };
+        let (was, now): (f64, f64) = (
+            cavity.iter().map(|&t| vol(&self.dt.tets[t as usize])).sum(),
+            new.iter().map(vol).sum(),
+        );
+        let closed = edges.values().all(|&c| c == 0) && (was - now).abs() <= 1e-9 * was.max(now);
+        closed.then_some((cavity, new))
     }
 
     /// Where a tet on a surface face is thin (a dihedral angle below [`LIFT_BELOW_DEG`]:
@@ -926,7 +1062,11 @@ impl<'a> Cdt<'a> {
         if (filled - enclosed).abs() > 1e-9 * filled.max(enclosed.abs()) {
             return Err("the filled tets overlap");
         }
-        Ok(Filled { pts, tets })
+        Ok(Filled {
+            pts,
+            tets,
+            grown: self.grown,
+        })
     }
 }
 
@@ -1260,5 +1400,26 @@ mod tests {
             let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(r.tets.len() >= faces.len() / 4, "{name}");
         }
+    }
+
+    /// OpenSCAD's example005 (a CAD part of needle triangles), filled from its boundary
+    /// points alone: four Steiner points have a nearly flat tet in their star, so every
+    /// inward step inverts a tet of the star itself; only a grown cavity takes them off
+    /// the surface (without [`Cdt::grown_star`] the fill fails there).
+    #[test]
+    fn a_star_no_point_sees_grows_into_a_cavity_one_does() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/openscad/example005.stl");
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let corners = s.corner_nodes();
+        let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
+        let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
+        let faces: Vec<[u32; 3]> = s
+            .triangles()
+            .iter()
+            .map(|t| [local(t[0]), local(t[1]), local(t[2])])
+            .collect();
+        let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("example005: {e}"));
+        assert!(r.grown > 0, "no cavity grown");
     }
 }

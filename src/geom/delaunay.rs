@@ -749,6 +749,20 @@ impl Delaunay {
                 }
             }
         }
+        // The cavity's faces must close up (every edge on two of them, once each way):
+        // in a tetrahedralization that is no longer Delaunay (after recovery and
+        // relocation), the sphere test can take a cavity pinched at an edge, whose new
+        // tets would leave a face without a neighbour.
+        let mut edges: HashMap<[u32; 2], i32> = HashMap::new();
+        for t in &new {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *edges.entry(sorted2(a, b)).or_insert(0) += if a < b { 1 } else { -1 };
+            }
+        }
+        if edges.values().any(|&c| c != 0) {
+            return fail(self);
+        }
         self.replace(&cav, &new);
         Some(s)
     }
