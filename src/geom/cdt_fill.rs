@@ -22,7 +22,7 @@
 //! rounded, which the final checks cover: the boundary faces must be the input triangles
 //! and every tet positive, or the fill reports what went wrong.
 
-use super::delaunay::{sorted2, sorted3, Delaunay, FACES, NONE};
+use super::delaunay::{closes_up, sorted2, sorted3, Delaunay, FACES, NONE};
 use super::predicates::{orient3d, projection_of};
 use super::tet_quality::dihedral_extremes;
 use super::vec3::{axpy, dist, dot, norm, sub, tet_det, tri_normal, P3};
@@ -906,15 +906,6 @@ impl<'a> Cdt<'a> {
         // The new tets tile the cavity when its boundary is a closed surface (every edge
         // on two faces, once each way) and they take its volume (a boundary pinched at a
         // vertex can wind twice around `q`).
-        let mut edges: HashMap<[u32; 2], i32> = HashMap::new();
-        for t in &new {
-            let j = t.iter().position(|&v| v == q).unwrap_or(3);
-            let f = FACES[j].map(|m| t[m]);
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                *edges.entry(sorted2(a, b)).or_insert(0) += if a < b { 1 } else { -1 };
-            }
-        }
         let vol = |t: &[u32; 4]| {
             let p = t.map(|v| self.dt.p(v));
             tet_det(p[0], p[1], p[2], p[3]).abs()
@@ -923,7 +914,11 @@ impl<'a> Cdt<'a> {
             cavity.iter().map(|&t| vol(&self.dt.tets[t as usize])).sum(),
             new.iter().map(vol).sum(),
         );
-        let closed = edges.values().all(|&c| c == 0) && (was - now).abs() <= 1e-9 * was.max(now);
+        let bases = new.iter().map(|t| {
+            let j = t.iter().position(|&v| v == q).unwrap_or(3);
+            FACES[j].map(|m| t[m])
+        });
+        let closed = closes_up(bases) && (was - now).abs() <= 1e-9 * was.max(now);
         closed.then_some((cavity, new))
     }
 
@@ -1383,20 +1378,26 @@ mod tests {
 
     /// Whole CAD parts (OpenSCAD exports) filled from their vertices alone: the
     /// hardest use of the fill (coplanar faces, cospherical points everywhere).
+    /// The corner points and outward triangles of `tests/data/openscad/NAME.stl`.
+    fn openscad_corners(name: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("tests/data/openscad/{name}.stl"));
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let corners = s.corner_nodes();
+        let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
+        let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
+        let faces: Vec<[u32; 3]> = s
+            .triangles()
+            .iter()
+            .map(|t| [local(t[0]), local(t[1]), local(t[2])])
+            .collect();
+        (pts, faces)
+    }
+
     #[test]
     fn openscad_parts_fill_with_their_boundary_kept() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad");
         for name in ["LetterBlock", "example002", "example013", "example014"] {
-            let path = dir.join(format!("{name}.stl"));
-            let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-            let corners = s.corner_nodes();
-            let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
-            let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
-            let faces: Vec<[u32; 3]> = s
-                .triangles()
-                .iter()
-                .map(|t| [local(t[0]), local(t[1]), local(t[2])])
-                .collect();
+            let (pts, faces) = openscad_corners(name);
             let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(r.tets.len() >= faces.len() / 4, "{name}");
         }
@@ -1408,17 +1409,7 @@ mod tests {
     /// the surface (without [`Cdt::grown_star`] the fill fails there).
     #[test]
     fn a_star_no_point_sees_grows_into_a_cavity_one_does() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/openscad/example005.stl");
-        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-        let corners = s.corner_nodes();
-        let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
-        let pts: Vec<P3> = corners.iter().map(|&c| s.nodes()[c as usize]).collect();
-        let faces: Vec<[u32; 3]> = s
-            .triangles()
-            .iter()
-            .map(|t| [local(t[0]), local(t[1]), local(t[2])])
-            .collect();
+        let (pts, faces) = openscad_corners("example005");
         let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("example005: {e}"));
         assert!(r.grown > 0, "no cavity grown");
     }

@@ -753,14 +753,7 @@ impl Delaunay {
         // in a tetrahedralization that is no longer Delaunay (after recovery and
         // relocation), the sphere test can take a cavity pinched at an edge, whose new
         // tets would leave a face without a neighbour.
-        let mut edges: HashMap<[u32; 2], i32> = HashMap::new();
-        for t in &new {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *edges.entry(sorted2(a, b)).or_insert(0) += if a < b { 1 } else { -1 };
-            }
-        }
-        if edges.values().any(|&c| c != 0) {
+        if !closes_up(new.iter().map(|t| [t[0], t[1], t[2]])) {
             return fail(self);
         }
         self.replace(&cav, &new);
@@ -933,6 +926,19 @@ impl Delaunay {
         }
         false
     }
+}
+
+/// Whether oriented triangles close up: every edge on two of them, once each way (the
+/// faces of a cavity, seen from the point that fills it).
+pub(crate) fn closes_up(tris: impl Iterator<Item = [u32; 3]>) -> bool {
+    let mut edges: HashMap<[u32; 2], i32> = HashMap::new();
+    for f in tris {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            *edges.entry(sorted2(a, b)).or_insert(0) += if a < b { 1 } else { -1 };
+        }
+    }
+    edges.values().all(|&c| c == 0)
 }
 
 #[cfg(test)]
