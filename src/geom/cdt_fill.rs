@@ -108,6 +108,8 @@ struct Cdt<'a> {
     split: Split,
     /// Steiner points moved off with a grown cavity.
     grown: usize,
+    /// Whether [`Cdt::move_off`] may grow a cavity (the last rounds only).
+    grow: bool,
 }
 
 impl<'a> Cdt<'a> {
@@ -138,6 +140,7 @@ impl<'a> Cdt<'a> {
             parent: HashMap::new(),
             split,
             grown: 0,
+            grow: false,
         })
     }
 
@@ -534,19 +537,27 @@ impl<'a> Cdt<'a> {
             .map(|s| (s, on_edge.get(&s).copied().unwrap_or(1)))
             .collect();
         // A point whose new star has no kernel yet may get one once its neighbours have
-        // moved: a few rounds over those left.
-        for _ in 0..MOVE_ROUNDS {
-            let mut stuck = Vec::new();
-            for &(s, n) in &left {
-                let n = self.remove_one(s, n)?;
-                if n > 0 {
-                    stuck.push((s, n));
+        // moved: a few rounds over those left. Then, for those still left, the same
+        // with grown cavities ([`Cdt::grown_star`]): their search costs more, and a point
+        // that would move in a later round does not pay it.
+        for grow in [false, true] {
+            self.grow = grow;
+            for _ in 0..MOVE_ROUNDS {
+                if left.is_empty() {
+                    break;
                 }
-            }
-            let progress = stuck.len() < left.len();
-            left = stuck;
-            if left.is_empty() || !progress {
-                break;
+                let mut stuck = Vec::new();
+                for &(s, n) in &left {
+                    let n = self.remove_one(s, n)?;
+                    if n > 0 {
+                        stuck.push((s, n));
+                    }
+                }
+                let progress = stuck.len() < left.len();
+                left = stuck;
+                if !progress {
+                    break;
+                }
             }
         }
         if left.is_empty() {
@@ -582,7 +593,9 @@ impl<'a> Cdt<'a> {
             }
             let mut comp = self.component(s, &star);
             let mut moved = None;
-            for attempt in 0..=MAX_UNBLOCK {
+            // With grown cavities (the last rounds), the flips were already tried.
+            let unblocks = if self.grow { 0 } else { MAX_UNBLOCK };
+            for attempt in 0..=unblocks {
                 if attempt > 0 {
                     let star = self.dt.star(s);
                     if star.is_empty() {
@@ -590,7 +603,7 @@ impl<'a> Cdt<'a> {
                     }
                     comp = self.component(s, &star);
                 }
-                match self.move_off(s, &comp, attempt < MAX_UNBLOCK)? {
+                match self.move_off(s, &comp, attempt < unblocks)? {
                     Some(0) => continue,
                     Some(usize::MAX) => {
                         moved = self.move_off(s, &comp, false)?;
@@ -793,7 +806,7 @@ impl<'a> Cdt<'a> {
             }));
         }
         let mut cavity = comp.to_vec();
-        if !placed && !unblock {
+        if !placed && !unblock && self.grow {
             // No point sees the star itself (a tet of it is nearly flat at `s`, so every
             // inward step crosses its far face): a larger cavity that some point near
             // `s` sees.
