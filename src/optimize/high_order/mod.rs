@@ -594,6 +594,15 @@ fn run_patch(
     let mut work = 0;
     if !mids.is_empty() {
         work += run_barrier(&mids, &mut v, &scale, prm, lb, lone);
+        // The barrier works on v / scale: a vertex variable it does not move comes back
+        // as (x / s) * s, an ulp off, which can invert a nearly flat corner tet with no
+        // check (stage A checks no corner). Back to the exact starting positions.
+        for el in &elems {
+            for &i in el.var[..4].iter().filter(|&&i| i != FIXED) {
+                let i = 3 * i as usize;
+                v[i..i + 3].copy_from_slice(&v0[i..i + 3]);
+            }
+        }
     }
     let mut scores = Vec::with_capacity(elems.len());
     let deficit = |s: &[f64]| s.iter().map(|&x| (prm.threshold - x).max(0.0)).sum::<f64>();
