@@ -857,8 +857,8 @@ impl<'a> Cdt<'a> {
     /// does not see strictly (positively) is crossed into the tet behind it, Bowyer-Watson
     /// fashion, until `q` sees them all: the cavity is then star-shaped from `q`, so the
     /// new tets fill it. None where the face to cross is a surface face, the tet behind it
-    /// has `s` (another pocket), the cavity passes [`GROW_LIMIT`] tets, a vertex would be
-    /// left in no tet, or `q` is not strictly inside `faces`.
+    /// has `s` (another pocket), the cavity passes [`GROW_LIMIT`] tets, or `q` is not
+    /// strictly inside `faces`; interior points the cavity swallows are dropped.
     fn grown_star(
         &self,
         s: u32,

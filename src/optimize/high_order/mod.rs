@@ -371,6 +371,7 @@ fn run_barrier(
         return 0;
     }
     let mut u: Vec<f64> = v.iter().zip(scale).map(|(x, s)| x / s).collect();
+    let start = v.to_vec();
     for _ in 0..prm.tune.barrier_updates {
         obj.eps = if mmin == 0.0 {
             -0.1
@@ -399,6 +400,7 @@ fn run_barrier(
         );
         // (The last evaluation may have been a rejected trial point.)
         unscale(&u, scale, v);
+        keep_unused(elems, v, &start);
         let (new, ratio) = obj.min_measure(v);
         let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
         mmin = new;
@@ -407,6 +409,22 @@ fn run_barrier(
         }
     }
     evals
+}
+
+/// Put back the variables no element of `elems` uses from `start`: [`unscale`] brings
+/// each back as (x / s) * s, which can be an ulp off, and a vertex the mid-node stage
+/// leaves fixed that way can invert a nearly flat corner tet that stage never checks
+/// (OpenSCAD's children.stl: two, after the whole fill).
+fn keep_unused(elems: &[PatchElem], v: &mut [f64], start: &[f64]) {
+    let mut used = vec![false; v.len() / 3];
+    for e in elems {
+        for &i in e.var.iter().filter(|&&i| i != FIXED) {
+            used[i as usize] = true;
+        }
+    }
+    for (i, _) in used.iter().enumerate().filter(|(_, &u)| !u) {
+        v[3 * i..3 * i + 3].copy_from_slice(&start[3 * i..3 * i + 3]);
+    }
 }
 
 /// The variables `v` of the scaled variables `u` (`v = u * scale`).
@@ -594,15 +612,6 @@ fn run_patch(
     let mut work = 0;
     if !mids.is_empty() {
         work += run_barrier(&mids, &mut v, &scale, prm, lb, lone);
-        // The barrier works on v / scale: a vertex variable it does not move comes back
-        // as (x / s) * s, an ulp off, which can invert a nearly flat corner tet with no
-        // check (stage A checks no corner). Back to the exact starting positions.
-        for el in &elems {
-            for &i in el.var[..4].iter().filter(|&&i| i != FIXED) {
-                let i = 3 * i as usize;
-                v[i..i + 3].copy_from_slice(&v0[i..i + 3]);
-            }
-        }
     }
     let mut scores = Vec::with_capacity(elems.len());
     let deficit = |s: &[f64]| s.iter().map(|&x| (prm.threshold - x).max(0.0)).sum::<f64>();
