@@ -7,10 +7,11 @@
 //! cubic lattice wherever the size is uniform, whose Delaunay tets are all alike and well
 //! shaped. A leaf is at most [`LEAF_PER_SIZE`] times the size at its centre; points
 //! nearer the surface than [`CLEARANCE`] times the size are dropped (the surface's own
-//! vertices are there), as are points outside (with the tets the fill discards) and
-//! points inside a surface edge's diametral ball or a triangle's equatorial ball: there
-//! they would keep the edge or triangle out of the Delaunay tetrahedralization and cost
-//! Steiner points on the surface (on CAD parts' long edges, hundreds).
+//! vertices are there), as are points inside a surface edge's diametral ball or a
+//! triangle's equatorial ball: there they would keep the edge or triangle out of the
+//! Delaunay tetrahedralization and cost Steiner points on the surface (on CAD parts' long
+//! edges, hundreds). Points outside the surface (exact ray parity) are left out too;
+//! the fill is tried with them only where it fails without them.
 //!
 //! The fill places Steiner points at segment crossings; where that fails it is run
 //! again halving the segments ([`Split`]).
@@ -48,10 +49,9 @@ pub(crate) fn whole_fill(
     corners.sort_unstable();
     corners.dedup();
     let local = |v: u32| corners.binary_search(&v).map_or(u32::MAX, |i| i as u32);
-    let mut pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
+    let pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
     let n_corners = pts.len();
     let interior = interior_points(&pts, surf_tris, &local, size)?;
-    pts.extend_from_slice(&interior);
     // The fill wants the region on each face's positive side: the outward input reversed.
     let faces: Vec<[u32; 3]> = surf_tris
         .iter()
@@ -59,12 +59,38 @@ pub(crate) fn whole_fill(
         .collect();
     // Thin tets on the surface get a point above it, at most a size high.
     let height = |p: P3| size.at(p);
-    // Steiner points at crossings first; halving where crossings pile up.
-    let filled =
-        cdt_fill::fill(&pts, &faces, Split::AtCrossing, Some(&height)).or_else(|first| {
-            cdt_fill::fill(&pts, &faces, Split::Halving, Some(&height))
-                .map_err(|second| format!("{first}; halving segments: {second}"))
-        })?;
+    // Steiner points at crossings first; halving where crossings pile up. With the
+    // points inside first; where that fails, with those outside too (they change the
+    // Delaunay tetrahedralization the recovery starts from, and with it where its
+    // Steiner points fall; their tets are dropped).
+    let mut why = Vec::new();
+    let mut filled = None;
+    'fills: for with_outside in [false, true] {
+        let mut all = pts.clone();
+        all.extend(
+            interior
+                .iter()
+                .filter(|&&(_, inside)| inside || with_outside)
+                .map(|&(p, _)| p),
+        );
+        for split in [Split::AtCrossing, Split::Halving] {
+            match cdt_fill::fill(&all, &faces, split, Some(&height)) {
+                Ok(f) => {
+                    filled = Some(f);
+                    break 'fills;
+                }
+                Err(e) => why.push(format!(
+                    "{e} ({split:?}{})",
+                    if with_outside {
+                        ", points outside too"
+                    } else {
+                        ""
+                    }
+                )),
+            }
+        }
+    }
+    let filled = filled.ok_or_else(|| why.join("; "))?;
     // Global ids: corners keep theirs; used interior and Steiner points follow the
     // surface nodes in order of first use.
     let mut out_pts = surf_nodes.to_vec();
@@ -98,13 +124,14 @@ pub(crate) fn whole_fill(
 
 /// Octree leaf centres and corners in the surface's box, at least [`CLEARANCE`] sizes
 /// from every triangle, in depth-first (Morton) order, so that consecutive points are
-/// near each other for the Delaunay insertion's walk.
+/// near each other for the Delaunay insertion's walk; each with whether the surface
+/// encloses it.
 fn interior_points(
     corner_pts: &[P3],
     surf_tris: &[[u32; 6]],
     local: &dyn Fn(u32) -> u32,
     size: &SizeField,
-) -> Result<Vec<P3>, String> {
+) -> Result<Vec<(P3, bool)>, String> {
     let bounds = Aabb::of(corner_pts);
     let ext = (0..3)
         .map(|d| bounds.hi[d] - bounds.lo[d])
@@ -186,7 +213,11 @@ fn interior_points(
             keep.push(p);
         }
     }
-    Ok(keep)
+    // Which are inside: those outside cost the Delaunay insertion and the boundary
+    // recovery their tets, then are dropped with them.
+    let tris: Vec<[P3; 3]> = surf_tris.iter().map(tri_pts).collect();
+    let inside = crate::surface::inside::enclosed(&tris, &keep);
+    Ok(keep.into_iter().zip(inside).collect())
 }
 
 /// The balls an interior point must stay out of for a surface triangle's edges and the
@@ -304,6 +335,27 @@ mod tests {
         check_whole_fill("tests/data/openscad/offset.stl");
         // Crossings next to nearly flat tets: recovered by halving the segments.
         check_whole_fill("tests/data/openscad/example007.stl");
+    }
+
+    /// The torus (R = 1, r = 0.35, axis z): every interior point is inside the tube, none
+    /// in the hole or the box's corners, and there are some.
+    #[test]
+    fn interior_points_are_all_inside() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/torus_p2.msh");
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let size = crate::generate::size_field(&s, &Options::default());
+        let id = |v: u32| v;
+        let pts = interior_points(s.nodes(), s.triangles(), &id, &size).unwrap();
+        let inside = pts.iter().filter(|p| p.1).count();
+        assert!(
+            inside > 10 && inside < pts.len(),
+            "{inside} of {}",
+            pts.len()
+        );
+        for &(p, inside) in &pts {
+            let ring = (p[0].hypot(p[1]) - 1.0).hypot(p[2]);
+            assert_eq!(inside, ring < 0.35, "{p:?}");
+        }
     }
 
     /// The linear stage on a whole fill with and without `guard_slivers`: the tets with a

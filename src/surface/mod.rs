@@ -40,6 +40,7 @@ mod exact_sum;
 pub mod geometry;
 mod grid;
 pub mod indices;
+pub(crate) mod inside;
 pub mod intersect;
 pub mod measure;
 pub mod orientation;
