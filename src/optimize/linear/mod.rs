@@ -285,8 +285,15 @@ fn attempt_left(prm: &LinearParams, st: &LinearStats) -> bool {
     st.attempts < (prm.max_attempts_per_tet * st.tets[0] as f64) as usize
 }
 
+/// Most tets per round whose vertices [`search_worst`] searches (the worst ones). Each
+/// vertex search evaluates its star at 960 trial points; a front's mesh has few tets to
+/// search, but the whole fill of a part with thin plates can have a third of its tets
+/// there, and searching them all then takes most of the stage's time.
+const SEARCH_MAX_TETS: usize = 1000;
+
 /// Sampled searches ([`search_vertex`]) for the vertices of the tets above
-/// `prm.search_skewness`, worst first; true when a vertex moved.
+/// `prm.search_skewness`, worst first (at most [`SEARCH_MAX_TETS`]); true when a vertex
+/// moved.
 fn search_worst(
     m: &mut LinMesh,
     prm: &LinearParams,
@@ -297,7 +304,7 @@ fn search_worst(
     let floor = 1.0 - prm.search_skewness;
     worst_first(m, floor, order);
     let mut moved = false;
-    for &(_, t, tv) in order.iter() {
+    for &(_, t, tv) in order.iter().take(SEARCH_MAX_TETS) {
         for &v in &tv {
             if m.tets[t as usize] == tv
                 && m.q[t as usize] < floor
