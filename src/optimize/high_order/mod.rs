@@ -730,6 +730,53 @@ mod tests {
         }
     }
 
+    /// A barrier run gives back the variables its elements do not use bit for bit, as
+    /// stage A (mid nodes only) leaves the patch's vertex variables: scaled and unscaled,
+    /// (x / s) * s can be an ulp off x, and an ulp was enough to invert a nearly flat
+    /// corner tet (OpenSCAD's children.stl, through the whole fill).
+    #[test]
+    fn a_barrier_gives_back_unused_variables_exactly() {
+        // Variable 0: mid node 4's offset; variable 1: corner 3, used by the full element
+        // only (it sets variable 1's length scale, as in a patch).
+        let mut va = [FIXED; 10];
+        va[4] = 0;
+        let mut vfull = va;
+        vfull[3] = 1;
+        // A corner whose coordinates do not all survive the round trip through the scale.
+        let (x, scale) = (0..1000)
+            .map(|k| {
+                let x = crate::geom::shape::straight_tet10([
+                    [0.0, 0.0, 0.0],
+                    [1.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0],
+                    [0.1, 0.2, 0.7 + 0.001 * f64::from(k)],
+                ]);
+                (x, length_scales(&[PatchElem::new(x, vfull)], 2))
+            })
+            .find(|(x, s)| (0..3).any(|d| x[3][d] / s[3 + d] * s[3 + d] != x[3][d]))
+            .expect("some corner makes a lossy round trip");
+        // Mid node 4 pushed far off its edge: a poor element for the barrier to improve.
+        let offset = [0.0, 0.45, 0.3];
+        let mut xm = x;
+        xm[4] = [0, 1, 2].map(|d| xm[4][d] + offset[d]);
+        let mids = [PatchElem::new(xm, va)];
+        let mut v: Vec<f64> = offset.iter().chain(&x[3]).copied().collect();
+        let before = v.clone();
+        let d = HighOrderParams::default();
+        let prm = RoundPrm {
+            stage: &d,
+            tune: &d.staged,
+            threshold: d.threshold,
+            vertices_below: d.vertices_below,
+        };
+        let work = run_barrier(&mids, &mut v, &scale, &prm, &mut Lbfgs::default(), &|| true);
+        assert!(work > 0 && v[..3] != before[..3], "the barrier did not run");
+        assert_eq!(
+            v[3..].iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            before[3..].iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+    }
+
     /// The cube of `cube(3, 0.05)` with its central mid node pushed out far enough to
     /// leave invalid elements.
     fn tangled_cube() -> (crate::optimize::testmesh::CubeMesh, TetMesh) {
