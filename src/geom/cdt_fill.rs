@@ -93,6 +93,10 @@ const GROW_LIMIT: usize = 400;
 /// Step lengths tried for a grown cavity's point: `reach / 2^k` for k in 2..this.
 const GROW_STEPS: i32 = 40;
 
+/// A Steiner point placed at a step below `reach / 2^this` tries a grown cavity seen
+/// from a larger step ([`Cdt::move_off`]).
+const TINY_STEP: i32 = 10;
+
 /// Rounds over the Steiner points not yet moved off the surface.
 const MOVE_ROUNDS: usize = 4;
 
@@ -765,6 +769,8 @@ impl<'a> Cdt<'a> {
             }
         };
         let mut placed = false;
+        // The step (reach / 2^k) of a placement along `dirs`, 0 for the kernel centre.
+        let mut placed_step = 0;
         if let Some(c) = kernel_centre(&walls, ps) {
             self.dt.pts[q as usize] = c;
             placed = all_positive(&self.dt);
@@ -782,6 +788,7 @@ impl<'a> Cdt<'a> {
                 self.dt.pts[q as usize] = p;
                 if all_positive(&self.dt) {
                     placed = true;
+                    placed_step = k;
                     break 'dirs;
                 }
             }
@@ -806,11 +813,21 @@ impl<'a> Cdt<'a> {
             }));
         }
         let mut cavity = comp.to_vec();
-        if !placed && !unblock && self.grow {
+        // Only a point at a tiny step sees the star: kept there, it would leave nearly
+        // flat tets at the surface that the linear stage cannot lift. A grown cavity
+        // seen from a larger step is taken instead where there is one.
+        let tiny = placed && placed_step > TINY_STEP;
+        if (!placed || tiny) && !unblock && (self.grow || tiny) {
             // No point sees the star itself (a tet of it is nearly flat at `s`, so every
             // inward step crosses its far face): a larger cavity that some point near
             // `s` sees.
             let faces: Vec<[u32; 4]> = tets[link.len()..].to_vec();
+            let at_tiny = self.dt.pts[q as usize];
+            let steps = if tiny {
+                2..TINY_STEP + 1
+            } else {
+                2..GROW_STEPS
+            };
             // The smallest such cavity over the candidate points.
             let mut best: Option<(P3, Vec<u32>, Vec<[u32; 4]>)> = None;
             for d in [inward, centre] {
@@ -818,7 +835,7 @@ impl<'a> Cdt<'a> {
                 if l.is_nan() || l <= 0.0 || !reach.is_finite() {
                     continue;
                 }
-                for k in 2..GROW_STEPS {
+                for k in steps.clone() {
                     let p = axpy(ps, reach * 0.5f64.powi(k) / l, d);
                     self.dt.pts[q as usize] = p;
                     if let Some((cav, new)) = self.grown_star(s, q, comp, &faces) {
@@ -829,11 +846,25 @@ impl<'a> Cdt<'a> {
                 }
             }
             if let Some((p, cav, new)) = best {
+                // The smallest cavity is seen from very near `s` (down to 2^-39 of the
+                // reach), which leaves nearly flat tets at the surface; the centre of the
+                // largest ball in the grown star's kernel is as far in as it can be.
+                let walls: Vec<[P3; 3]> = new
+                    .iter()
+                    .map(|tv| {
+                        let j = tv.iter().position(|&v| v == q).unwrap_or(3);
+                        let f = FACES[j];
+                        [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
+                    })
+                    .collect();
+                let p = kernel_centre(&walls, p).unwrap_or(p);
                 self.dt.pts[q as usize] = p;
                 cavity = cav;
                 tets = new;
                 placed = true;
                 self.grown += 1;
+            } else if tiny {
+                self.dt.pts[q as usize] = at_tiny;
             }
         }
         if !placed {
