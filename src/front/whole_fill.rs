@@ -337,10 +337,10 @@ mod tests {
         check_whole_fill("tests/data/openscad/example007.stl");
     }
 
-    /// The torus (R = 1, r = 0.35, axis z): every interior point is inside the tube, none
-    /// in the hole or the box's corners, and there are some.
+    /// The torus (R = 1, r = 0.35, axis z): the candidates inside the tube are marked
+    /// inside, those in the hole and the box's corners outside, and there are both.
     #[test]
-    fn interior_points_are_all_inside() {
+    fn interior_points_know_whether_the_surface_encloses_them() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/torus_p2.msh");
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
