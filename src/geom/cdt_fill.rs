@@ -749,14 +749,7 @@ impl<'a> Cdt<'a> {
         }
         // Best: the centre of the largest ball in the new star's kernel (each new tet
         // positive is one half-space for the point); else small steps along `dirs`.
-        let walls: Vec<[P3; 3]> = tets
-            .iter()
-            .map(|tv| {
-                let j = tv.iter().position(|&v| v == q).unwrap_or(3);
-                let f = FACES[j];
-                [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
-            })
-            .collect();
+        let walls = self.walls(&tets, q);
         // Whether every new tet is positive, testing first the one that failed last: a
         // step along a direction mostly fails on the same tet, so most candidates cost
         // one orientation test instead of one per tet (on OpenSCAD's example012 these
@@ -856,15 +849,7 @@ impl<'a> Cdt<'a> {
                 // The smallest cavity is seen from very near `s` (down to 2^-39 of the
                 // reach), which leaves nearly flat tets at the surface; the centre of the
                 // largest ball in the grown star's kernel is as far in as it can be.
-                let walls: Vec<[P3; 3]> = new
-                    .iter()
-                    .map(|tv| {
-                        let j = tv.iter().position(|&v| v == q).unwrap_or(3);
-                        let f = FACES[j];
-                        [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
-                    })
-                    .collect();
-                let p = kernel_centre(&walls, p).unwrap_or(p);
+                let p = kernel_centre(&self.walls(&new, q), p).unwrap_or(p);
                 self.dt.pts[q as usize] = p;
                 cavity = cav;
                 tets = new;
@@ -890,6 +875,19 @@ impl<'a> Cdt<'a> {
             self.parent.insert(sorted3(g), i);
         }
         Ok(Some(groups.len()))
+    }
+
+    /// The faces of tets `tets` opposite their vertex `q`, turned so that `q` is on
+    /// their positive side when the tet is positive: the walls of `q`'s star, as
+    /// [`kernel_centre`] takes them.
+    fn walls(&self, tets: &[[u32; 4]], q: u32) -> Vec<[P3; 3]> {
+        tets.iter()
+            .map(|tv| {
+                let j = tv.iter().position(|&v| v == q).unwrap_or(3);
+                let f = FACES[j];
+                [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
+            })
+            .collect()
     }
 
     /// The cavity that the new point `q` (at its current position) sees, grown from the
@@ -1338,25 +1336,7 @@ mod tests {
     }
 
     fn cube() -> (Vec<P3>, Vec<[u32; 3]>) {
-        let mut pts = Vec::new();
-        for i in 0..8 {
-            pts.push([(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]);
-        }
-        // Outward quads split into triangles.
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let mut f = Vec::new();
-        for q in quads {
-            f.push([q[0], q[1], q[2]]);
-            f.push([q[0], q[2], q[3]]);
-        }
-        (pts, f)
+        crate::geom::testutil::unit_cube()
     }
 
     #[test]

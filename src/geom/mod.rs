@@ -9,7 +9,7 @@ pub mod predicates;
 pub mod quadrature;
 pub mod shape;
 #[cfg(test)]
-mod testutil;
+pub(crate) mod testutil;
 pub mod tet_quality;
 pub mod vec3;
 

@@ -1,5 +1,5 @@
 //! Shared helpers for the geometry unit tests (random well-shaped and curved tets,
-//! reference-tet lattices).
+//! reference-tet lattices, the unit cube's surface).
 
 use super::shape::straight_tet10;
 use super::vec3::{tet_det, P3};
@@ -79,4 +79,25 @@ pub fn random_curved(rng: &mut StdRng, amp: f64) -> [P3; 10] {
         }
     }
     x
+}
+
+/// The unit cube's corners (bit 0: x, bit 1: y, bit 2: z) and its 12 outward triangles.
+pub fn unit_cube() -> (Vec<P3>, Vec<[u32; 3]>) {
+    let pts = (0..8u32)
+        .map(|i| [i & 1, (i >> 1) & 1, (i >> 2) & 1].map(f64::from))
+        .collect();
+    // Outward quads split into triangles.
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let faces = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    (pts, faces)
 }

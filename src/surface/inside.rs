@@ -34,19 +34,8 @@ mod tests {
 
     /// The unit cube's 12 triangles (outward).
     fn cube() -> Vec<[P3; 3]> {
-        let v = |i: usize| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64];
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        quads
-            .iter()
-            .flat_map(|q| [[v(q[0]), v(q[1]), v(q[2])], [v(q[0]), v(q[2]), v(q[3])]])
-            .collect()
+        let (pts, faces) = crate::geom::testutil::unit_cube();
+        faces.iter().map(|f| f.map(|v| pts[v as usize])).collect()
     }
 
     /// Points on the lines of the cube's edges and diagonals (rays through its edges
