@@ -715,18 +715,15 @@ impl<'a> Cdt<'a> {
             new_faces.extend(tris.into_iter().map(|t| (t, i)));
         }
         let ps = self.dt.p(s);
-        let reach = link
+        // The nearest and the farthest star vertex.
+        let (reach, span) = link
             .iter()
             .flatten()
             .filter(|&&v| v != s)
             .map(|&v| dist(ps, self.dt.p(v)))
-            .fold(f64::INFINITY, f64::min);
-        let span = link
-            .iter()
-            .flatten()
-            .filter(|&&v| v != s)
-            .map(|&v| dist(ps, self.dt.p(v)))
-            .fold(0.0, f64::max);
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), d| {
+                (lo.min(d), hi.max(d))
+            });
         let centre = {
             let vs: Vec<P3> = link
                 .iter()
@@ -836,13 +833,10 @@ impl<'a> Cdt<'a> {
             };
             // The smallest such cavity over the candidate points.
             let mut best: Option<(P3, Vec<u32>, Vec<[u32; 4]>)> = None;
+            let base = if tiny { span } else { reach };
             for d in [inward, centre] {
                 let l = norm(d);
-                if l.is_nan() || l <= 0.0 || !reach.is_finite() {
-                    continue;
-                }
-                let base = if tiny { span } else { reach };
-                if !base.is_finite() || base <= 0.0 {
+                if l.is_nan() || l <= 0.0 || !base.is_finite() || base <= 0.0 {
                     continue;
                 }
                 for k in steps.clone() {
@@ -892,10 +886,9 @@ impl<'a> Cdt<'a> {
     /// [`kernel_centre`] takes them.
     fn walls(&self, tets: &[[u32; 4]], q: u32) -> Vec<[P3; 3]> {
         tets.iter()
-            .map(|tv| {
-                let j = tv.iter().position(|&v| v == q).unwrap_or(3);
-                let f = FACES[j];
-                [tv[f[0]], tv[f[2]], tv[f[1]]].map(|v| self.dt.p(v))
+            .map(|t| {
+                let f = opposite(t, q);
+                [f[0], f[2], f[1]].map(|v| self.dt.p(v))
             })
             .collect()
     }
@@ -976,10 +969,7 @@ impl<'a> Cdt<'a> {
             cavity.iter().map(|&t| vol(&self.dt.tets[t as usize])).sum(),
             new.iter().map(vol).sum(),
         );
-        let bases = new.iter().map(|t| {
-            let j = t.iter().position(|&v| v == q).unwrap_or(3);
-            FACES[j].map(|m| t[m])
-        });
+        let bases = new.iter().map(|t| opposite(t, q));
         let closed = closes_up(bases) && (was - now).abs() <= 1e-9 * was.max(now);
         closed.then_some((cavity, new))
     }
@@ -1126,6 +1116,13 @@ impl<'a> Cdt<'a> {
             tiny: self.tiny,
         })
     }
+}
+
+/// The face of tet `t` opposite its vertex `q` (the last face when `q` is not in it),
+/// in [`FACES`] order.
+fn opposite(t: &[u32; 4], q: u32) -> [u32; 3] {
+    let j = t.iter().position(|&v| v == q).unwrap_or(3);
+    FACES[j].map(|m| t[m])
 }
 
 /// A face with its smallest id first (same orientation).

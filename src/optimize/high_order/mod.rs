@@ -371,6 +371,7 @@ fn run_barrier(
         return 0;
     }
     let mut u: Vec<f64> = v.iter().zip(scale).map(|(x, s)| x / s).collect();
+    let unused = unused_vars(elems, v.len() / 3);
     let start = v.to_vec();
     for _ in 0..prm.tune.barrier_updates {
         obj.eps = if mmin == 0.0 {
@@ -400,7 +401,9 @@ fn run_barrier(
         );
         // (The last evaluation may have been a rejected trial point.)
         unscale(&u, scale, v);
-        keep_unused(elems, v, &start);
+        for &i in &unused {
+            v[3 * i..3 * i + 3].copy_from_slice(&start[3 * i..3 * i + 3]);
+        }
         let (new, ratio) = obj.min_measure(v);
         let stagnated = (new - mmin).abs() < 0.01 * mmin.abs().max(1e-3);
         mmin = new;
@@ -411,20 +414,18 @@ fn run_barrier(
     evals
 }
 
-/// Put back the variables no element of `elems` uses from `start`: [`unscale`] brings
-/// each back as (x / s) * s, which can be an ulp off, and a vertex the mid-node stage
-/// leaves fixed that way can invert a nearly flat corner tet that stage never checks
-/// (OpenSCAD's children.stl: two, after the whole fill).
-fn keep_unused(elems: &[PatchElem], v: &mut [f64], start: &[f64]) {
-    let mut used = vec![false; v.len() / 3];
+/// The variables (of `n`) no element of `elems` uses. [`run_barrier`] puts them back as
+/// they were: [`unscale`] brings each back as (x / s) * s, which can be an ulp off, and a
+/// vertex the mid-node stage leaves fixed that way can invert a nearly flat corner tet
+/// that stage never checks (OpenSCAD's children.stl: two, after the whole fill).
+fn unused_vars(elems: &[PatchElem], n: usize) -> Vec<usize> {
+    let mut used = vec![false; n];
     for e in elems {
         for &i in e.var.iter().filter(|&&i| i != FIXED) {
             used[i as usize] = true;
         }
     }
-    for (i, _) in used.iter().enumerate().filter(|(_, &u)| !u) {
-        v[3 * i..3 * i + 3].copy_from_slice(&start[3 * i..3 * i + 3]);
-    }
+    (0..n).filter(|&i| !used[i]).collect()
 }
 
 /// The variables `v` of the scaled variables `u` (`v = u * scale`).
