@@ -97,13 +97,18 @@ const GROW_LIMIT: usize = 400;
 /// Step lengths tried for a grown cavity's point: `reach / 2^k` for k in 2..this.
 const GROW_STEPS: i32 = 40;
 
-/// A Steiner point placed nearer than `span / 2^this` to where it was on the surface
-/// (`span`: its farthest star vertex) tries a grown cavity seen from a larger step
+/// A Steiner point placed nearer than `span / 2^this` to the planes of the input faces
+/// it was on (`span`: its farthest star vertex) tries a grown cavity seen from higher up
 /// ([`Cdt::move_off`]): relative to the star's long edges it is still on the surface.
 const TINY_STEP: i32 = 10;
 
 /// Rounds over the Steiner points not yet moved off the surface.
 const MOVE_ROUNDS: usize = 4;
+
+/// Link tets whose centroid directions a Steiner point's move tries. A point in a
+/// cospherical ring (a cylinder's cap of many facets) has thousands of link tets, and each
+/// direction costs dozens of steps per try; a typical star has fewer than this.
+const MAX_LINK_DIRS: usize = 32;
 
 struct Cdt<'a> {
     dt: Delaunay,
@@ -639,20 +644,7 @@ impl<'a> Cdt<'a> {
     /// The tets of `star` (all containing `s`) linked to its first through faces at `s`.
     fn component(&self, s: u32, star: &[u32]) -> Vec<u32> {
         let set: HashSet<u32> = star.iter().copied().collect();
-        let mut out = vec![star[0]];
-        let mut k = 0;
-        while k < out.len() {
-            let t = out[k];
-            k += 1;
-            let tv = self.dt.tets[t as usize];
-            for (j, &v) in tv.iter().enumerate() {
-                let nb = self.dt.adj[t as usize][j];
-                if v != s && nb != NONE && set.contains(&nb) && !out.contains(&nb) {
-                    out.push(nb);
-                }
-            }
-        }
-        out
+        self.dt.walk_around(s, star[0], |t| set.contains(&t))
     }
 
     /// Move Steiner point `s` off the surface within the tets `comp` around it. Returns
@@ -714,6 +706,21 @@ impl<'a> Cdt<'a> {
             .ok_or("the faces at a Steiner point cannot be retriangulated")?;
             new_faces.extend(tris.into_iter().map(|t| (t, i)));
         }
+        // How far a point is off the surface here: its distance to the nearest plane of
+        // the input faces at `s`.
+        let planes: Vec<[P3; 3]> = groups
+            .keys()
+            .map(|&i| self.faces[i].map(|v| self.dt.p(v)))
+            .collect();
+        let height = |p: P3| {
+            planes
+                .iter()
+                .map(|f| {
+                    let n = norm(tri_normal(f[0], f[1], f[2])).max(f64::MIN_POSITIVE);
+                    tet_det(f[0], f[1], f[2], p).abs() / n
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
         let ps = self.dt.p(s);
         // The nearest and the farthest star vertex.
         let (reach, span) = link
@@ -742,9 +749,12 @@ impl<'a> Cdt<'a> {
             .collect();
         tets.extend(new_faces.iter().map(|(g, _)| [g[0], g[2], g[1], q]));
         // Candidate directions: the inward normal, toward the star's centre, toward each
-        // link tet's centroid.
+        // link tet's centroid (at most [`MAX_LINK_DIRS`] of them, evenly spread).
         let mut dirs = vec![inward, centre];
-        for tv in &link {
+        for tv in link
+            .iter()
+            .step_by(link.len().div_ceil(MAX_LINK_DIRS).max(1))
+        {
             let c = tv
                 .iter()
                 .filter(|&&v| v != s)
@@ -814,13 +824,15 @@ impl<'a> Cdt<'a> {
             }));
         }
         let mut cavity = comp.to_vec();
-        // Only a point at a tiny step (relative to the star's longest reach, not the
-        // shortest: Steiner points on one segment crowd each other) sees the star: kept
-        // there, it would leave nearly flat tets at the surface that the linear stage
-        // cannot lift. A grown cavity seen from a larger step is taken instead where
-        // there is one.
-        let tiny = placed && dist(self.dt.pts[q as usize], ps) < span * 0.5f64.powi(TINY_STEP);
+        // Only a point a tiny height off the surface (relative to the star's longest
+        // reach, not the shortest: Steiner points on one segment crowd each other) sees
+        // the star: kept there, it would leave nearly flat tets at the surface that the
+        // linear stage cannot lift. The height, not the step: a kernel centre can lie
+        // far along the surface and a hair above it. A grown cavity seen from higher up
+        // is taken instead where there is one.
+        let limit = span * 0.5f64.powi(TINY_STEP);
         let at_tiny_step = self.dt.pts[q as usize];
+        let tiny = placed && height(at_tiny_step) < limit;
         if tiny || (!placed && !unblock && self.grow) {
             // No point sees the star itself (a tet of it is nearly flat at `s`, so every
             // inward step crosses its far face): a larger cavity that some point near
@@ -863,7 +875,7 @@ impl<'a> Cdt<'a> {
                 self.dt.pts[q as usize] = at_tiny_step;
             }
         }
-        if tiny && self.dt.pts[q as usize] == at_tiny_step {
+        if tiny && self.dt.pts[q as usize] == at_tiny_step && dist(at_tiny_step, ps) < limit {
             self.tiny += 1;
         }
         if !placed {
@@ -1465,5 +1477,42 @@ mod tests {
         let (pts, faces) = openscad_corners("example005");
         let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("example005: {e}"));
         assert_eq!(r.tiny, 0, "Steiner points left at a tiny step");
+    }
+
+    /// OpenSCAD's offset: 12 of its Steiner points had moved off the surface by a fair
+    /// step, but along it: they ended within 1e-6 of the part's size of a surface face,
+    /// where the linear stage cannot lift the flat tets they make. Measured by the height
+    /// above the faces, each gets a grown cavity seen from higher up instead.
+    #[test]
+    fn no_steiner_point_moves_along_the_surface_instead_of_off_it() {
+        let (pts, faces) = openscad_corners("offset");
+        let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("offset: {e}"));
+        let (lo, hi) = pts.iter().fold(
+            ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(lo, hi), p| {
+                (
+                    std::array::from_fn(|d| lo[d].min(p[d])),
+                    std::array::from_fn(|d| hi[d].max(p[d])),
+                )
+            },
+        );
+        let near = 1e-6 * dist(lo, hi);
+        // Steiner points within `near` of a surface triangle's plane, over the triangle.
+        let hugging = r.pts[pts.len()..]
+            .iter()
+            .filter(|&&p| {
+                faces.iter().any(|f| {
+                    let a = f.map(|v| pts[v as usize]);
+                    let n = tri_normal(a[0], a[1], a[2]);
+                    let over = (0..3).all(|k| {
+                        let e = sub(a[(k + 1) % 3], a[k]);
+                        dot(super::super::vec3::cross(e, sub(p, a[k])), n) >= 0.0
+                    });
+                    over && (tet_det(a[0], a[1], a[2], p) / norm(n)).abs() < near
+                })
+            })
+            .count();
+        assert!(r.pts.len() > pts.len(), "offset needs Steiner points");
+        assert_eq!(hugging, 0, "Steiner points hugging the surface");
     }
 }

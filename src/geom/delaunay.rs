@@ -535,7 +535,15 @@ impl Delaunay {
                 .filter(|&t| self.alive[t as usize] && self.tets[t as usize].contains(&v))
                 .collect();
         }
+        self.walk_around(v, t0, |_| true)
+    }
+
+    /// The tets containing vertex `v` reached from `t0` across faces through `v`, entering
+    /// only tets `keep` accepts. Linear in the star's size: a cospherical ring (a
+    /// cylinder's cap of many facets) gives a point thousands of tets.
+    pub(crate) fn walk_around(&self, v: u32, t0: u32, keep: impl Fn(u32) -> bool) -> Vec<u32> {
         let mut out = vec![t0];
+        let mut seen: HashSet<u32> = HashSet::from([t0]);
         let mut k = 0;
         while k < out.len() {
             let t = out[k];
@@ -546,7 +554,7 @@ impl Delaunay {
                     continue;
                 }
                 let nb = self.adj[t as usize][j];
-                if nb != NONE && !out.contains(&nb) {
+                if nb != NONE && keep(nb) && seen.insert(nb) {
                     out.push(nb);
                 }
             }
