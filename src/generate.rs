@@ -174,9 +174,10 @@ fn generate_inner(
                 front.tets,
                 Some(&front.quality),
                 &bnd,
-                &LinearParams {
-                    guard_slivers: front.stats.whole_fill,
-                    ..LinearParams::default()
+                &if front.stats.whole_fill {
+                    LinearParams::for_whole_fill()
+                } else {
+                    LinearParams::default()
                 },
             );
             ostats.linear = st;
