@@ -1313,6 +1313,7 @@ fn segment_line(a: P3, b: P3, x: P3, y: P3) -> P3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::distance::point_triangle_dist2;
 
     /// Fill `faces` (outward, as surfaces are stored) and check the result: positive tets,
     /// boundary exactly the input, volume the enclosed one.
@@ -1480,7 +1481,7 @@ mod tests {
     }
 
     /// OpenSCAD's offset: 12 of its Steiner points had moved off the surface by a fair
-    /// step, but along it: they ended within 1e-6 of the part's size of a surface face,
+    /// step, but along it: they ended within 1e-6 of the part's size of a surface triangle,
     /// where the linear stage cannot lift the flat tets they make. Measured by the height
     /// above the faces, each gets a grown cavity seen from higher up instead.
     #[test]
@@ -1497,18 +1498,13 @@ mod tests {
             },
         );
         let near = 1e-6 * dist(lo, hi);
-        // Steiner points within `near` of a surface triangle's plane, over the triangle.
+        // Steiner points within `near` of a surface triangle.
         let hugging = r.pts[pts.len()..]
             .iter()
             .filter(|&&p| {
                 faces.iter().any(|f| {
                     let a = f.map(|v| pts[v as usize]);
-                    let n = tri_normal(a[0], a[1], a[2]);
-                    let over = (0..3).all(|k| {
-                        let e = sub(a[(k + 1) % 3], a[k]);
-                        dot(super::super::vec3::cross(e, sub(p, a[k])), n) >= 0.0
-                    });
-                    over && (tet_det(a[0], a[1], a[2], p) / norm(n)).abs() < near
+                    point_triangle_dist2(p, a[0], a[1], a[2]) < near * near
                 })
             })
             .count();
