@@ -314,7 +314,14 @@ pub(crate) struct Mesher<'a> {
     /// Steps without a new most-filled volume after which the attempt stalls
     /// ([`stall_limit`]).
     stall_limit: u64,
-    /// Set when the attempt gave up by [`Mesher::stall_limit`].
+    /// Validity-test work without a new most-filled volume after which the attempt
+    /// stalls ([`stall_work_limit`]).
+    stall_work_limit: u64,
+    /// Validity-test work so far: front faces gathered for a candidate's test, plus one
+    /// per gather (see [`stall_work_limit`]).
+    work: u64,
+    /// Set when the attempt gave up by [`Mesher::stall_limit`] or
+    /// [`Mesher::stall_work_limit`].
     stalled: bool,
     /// Close stuck cavities by the constrained fill (off only in tests of the repair path).
     use_fill: bool,
@@ -387,6 +394,8 @@ impl<'a> Mesher<'a> {
             fewest_open: (usize::MAX, 0),
             max_repairs_without_progress: repairs_without_progress_limit(0),
             stall_limit: stall_limit(surf_tris.len()),
+            stall_work_limit: stall_work_limit(surf_tris.len()),
+            work: 0,
             stalled: false,
             use_fill: fill_enabled(),
             fill_p2_invalid: true,
@@ -598,7 +607,7 @@ impl<'a> Mesher<'a> {
         let max_repairs = 50 + self.surf_tris.len() as u64;
         let mut last_report = 0.0;
         // The most volume filled so far, and the step that filled it.
-        let (mut best_volume, mut best_step) = (0.0f64, 0u64);
+        let (mut best_volume, mut best_step, mut best_work) = (0.0f64, 0u64, 0u64);
         while let Some((tries, fid, ver)) = self.queue.pop() {
             let f = self.faces[fid as usize];
             if !f.alive || f.tries != tries || f.ver != ver {
@@ -614,12 +623,16 @@ impl<'a> Mesher<'a> {
             if self.volume_done > best_volume {
                 best_volume = self.volume_done;
                 best_step = self.stats.steps;
+                best_work = self.work;
             }
-            if self.stats.steps - best_step > self.stall_limit {
+            if self.stats.steps - best_step > self.stall_limit
+                || self.work - best_work > self.stall_work_limit
+            {
                 self.stalled = true;
                 let why = format!(
-                    "{} steps without filling more of the volume",
-                    self.stats.steps - best_step
+                    "{} steps ({} face tests) without filling more of the volume",
+                    self.stats.steps - best_step,
+                    self.work - best_work
                 );
                 return Err(self.stuck_error(fid, &why));
             }
@@ -1060,6 +1073,7 @@ impl<'a> Mesher<'a> {
         let alive = &self.face_alive;
         let mut ids = std::mem::take(&mut self.near_ids);
         self.grid.query(bb, |i| alive[i as usize], &mut ids);
+        self.work += 1 + ids.len() as u64;
         self.near.clear();
         for &i in &ids {
             if i != exclude {
@@ -1171,6 +1185,24 @@ const STALL_STEPS_BASE: u64 = 2_000;
 /// each). Deterministic: counted in steps, not time.
 fn stall_limit(surf_tris: usize) -> u64 {
     STALL_STEPS_PER_TRIANGLE * surf_tris as u64 + STALL_STEPS_BASE
+}
+
+/// Validity-test work per surface triangle, and in all, that a front attempt may spend
+/// without filling more of the volume than ever before ([`stall_work_limit`]).
+const STALL_WORK_PER_TRIANGLE: u64 = 20_000;
+const STALL_WORK_BASE: u64 = 100_000_000;
+
+/// [`stall_limit`] counted in work rather than steps: near the end of a stuck attempt
+/// each step tries every relaxation level on dozens of candidates, each tested against
+/// hundreds of front faces, so a step costs 100 times what it does early on and a step
+/// bound alone let attempts stall for half a minute. The work is the number of front
+/// faces gathered for the validity tests (plus one per gather), deterministic like the
+/// step count. Measured on the OpenSCAD corpus (about 1e8 of these per second here):
+/// attempts that closed went at most 8.4e7 without a new most-filled volume
+/// (example018, 4,960 triangles; 5e6 or less on the others), while stuck ones went on
+/// for 1e9-2e9 (linear_extrude, example024) before the step bound stopped them.
+fn stall_work_limit(surf_tris: usize) -> u64 {
+    STALL_WORK_PER_TRIANGLE * surf_tris as u64 + STALL_WORK_BASE
 }
 
 /// Restart schedule, as (alpha factor, size factor): when local remeshing cannot close the
@@ -1353,6 +1385,29 @@ mod tests {
         assert!(g.front.whole_fill, "{:?}", g.front);
         assert_eq!(g.report.num_invalid, 0);
         assert!(g.report.quality.scaled_jacobian_certified.min > 0.0);
+    }
+
+    /// OpenSCAD's offset: the first attempt cycles near the end, and each of those steps
+    /// tests dozens of candidates against hundreds of faces; the work bound ends it
+    /// before the step bound would (which ran for 15,041 steps past the best volume).
+    #[test]
+    fn a_cycling_attempt_stalls_by_its_work_before_its_step_bound() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad/offset.stl");
+        let s = crate::io::read_any_surface(&path, &Default::default()).expect("offset");
+        let opts = Options::default();
+        let size = crate::generate::size_field(&s, &opts);
+        let mut m = Mesher::new(s.nodes(), s.triangles(), &opts, &size);
+        let Err(Error::MeshingFailed { msg, .. }) = m.run(&mut |_, _| false) else {
+            panic!("offset's first attempt was expected to stall");
+        };
+        assert!(m.stalled, "{msg}");
+        let steps: u64 = msg
+            .split(' ')
+            .next()
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("{msg}"));
+        assert!(steps <= m.stall_limit, "{msg}");
     }
 
     #[test]
