@@ -519,6 +519,13 @@ fn run_mesh(
             return Err(e);
         }
     };
+    if g.optimize.chords > 0 {
+        eprintln!(
+            "warning: {} boundary edges are straight (the input's own edges): no curved \
+             element on them could be certified",
+            g.optimize.chords
+        );
+    }
     let t = std::time::Instant::now();
     io::write_mesh(output, &g.mesh, &m.write.options())?;
     let write_seconds = t.elapsed().as_secs_f64();

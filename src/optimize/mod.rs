@@ -37,4 +37,7 @@ pub struct OptimizeStats {
     pub time_linear: f64,
     /// Wall-clock seconds of the high-order stage.
     pub time_high_order: f64,
+    /// Boundary edges put back on their chords (a surface curved from a linear one)
+    /// where curved elements could not be certified.
+    pub chords: usize,
 }

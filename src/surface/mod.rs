@@ -93,6 +93,10 @@ pub struct Surface {
     /// Per triangle, its shell (connected component), numbered by lowest triangle.
     shell: Vec<u32>,
     shell_count: usize,
+    /// The mid nodes are curvetet's own: the surface was curved from a linear one
+    /// ([`curve::curve_linear`]), whose boundary is the straight edges. The mesher may put a
+    /// mid node back on its chord where a curved boundary element cannot be certified.
+    chords_allowed: bool,
 }
 
 impl Surface {
@@ -274,7 +278,21 @@ impl Surface {
             neighbors,
             shell: topo.shell,
             shell_count: topo.shell_count,
+            chords_allowed: false,
         })
+    }
+
+    /// Whether a mid node may go back on its chord (see [`Surface::with_chords_allowed`]).
+    pub(crate) fn chords_allowed(&self) -> bool {
+        self.chords_allowed
+    }
+
+    /// Mark the mid nodes as curvetet's own (a surface curved from a linear one): where
+    /// a curved boundary element cannot be certified, the mesher may straighten its
+    /// boundary edges back to the input's chords.
+    pub(crate) fn with_chords_allowed(mut self) -> Surface {
+        self.chords_allowed = true;
+        self
     }
 
     /// Nodes (corners and mid-edge nodes).

@@ -428,7 +428,7 @@ fn curve_checked(
             nodes[n_input + e] != crate::geom::vec3::mid(nodes[a as usize], nodes[b as usize])
         })
         .count();
-    Ok((surface, report))
+    Ok((surface.with_chords_allowed(), report))
 }
 
 /// [`check::check_linear`]; when `repair` allows and the triangles are not consistently
