@@ -380,6 +380,45 @@ mod tests {
             .count()
     }
 
+    /// The tets with a dihedral angle below 1° after the linear stage on a whole fill,
+    /// with `prm`, and those of them with a corner off the surface.
+    fn flat_tets_after_linear(path: &str, prm: &crate::optimize::LinearParams) -> (usize, usize) {
+        use crate::geom::tet_quality::dihedral_extremes;
+        use crate::optimize::linear::improve_linear;
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let size = crate::generate::size_field(&s, &Options::default());
+        let out = whole_fill(s.nodes(), s.triangles(), &size).unwrap();
+        let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles());
+        let (pts, tets, _) = improve_linear(out.pts, out.tets, &bnd, prm);
+        let flat: Vec<_> = tets
+            .iter()
+            .filter(|t| dihedral_extremes(&t.map(|v| pts[v as usize])).0 < 1.0)
+            .collect();
+        let inner = flat
+            .iter()
+            .filter(|t| t.iter().any(|&v| !bnd.is_fixed(v)))
+            .count();
+        (flat.len(), inner)
+    }
+
+    #[test]
+    fn the_flat_passes_leave_fewer_nearly_flat_tets() {
+        use crate::optimize::LinearParams;
+        let path = "tests/data/openscad/example005.stl";
+        let no_flat_passes = LinearParams {
+            flat_skewness: None,
+            ..LinearParams::for_whole_fill()
+        };
+        let (_, without) = flat_tets_after_linear(path, &no_flat_passes);
+        let (_, with) = flat_tets_after_linear(path, &LinearParams::for_whole_fill());
+        // Measured: 224 without the flat passes, 143 with them.
+        assert!(
+            4 * with < 3 * without,
+            "{with} nearly flat tets off the surface with the flat passes, {without} without"
+        );
+    }
+
     #[test]
     fn the_sliver_guard_keeps_splits_from_spreading_slivers_inward() {
         let path = "tests/data/openscad/example002.stl";

@@ -78,6 +78,10 @@ pub struct LinearParams {
     /// whose tets next to the surface are poor and where the splits spread slivers
     /// inward: OpenSCAD's sign made 2,055 interior slivers without it, 1,182 with it.
     pub guard_slivers: bool,
+    /// After the passes and searches: passes aimed only at tets above this skewness
+    /// (nearly flat), with a budget of their own (one attempt per tet of the input), up
+    /// to [`LinearParams::max_passes`]. None: no such passes.
+    pub flat_skewness: Option<f64>,
 }
 
 impl Default for LinearParams {
@@ -90,24 +94,24 @@ impl Default for LinearParams {
             max_attempts_per_tet: 2.0,
             reach: 0.05,
             guard_slivers: false,
+            flat_skewness: None,
         }
     }
 }
 
 impl LinearParams {
     /// For a whole fill's tets ([`crate::front::FrontStats::whole_fill`]): splits guarded
-    /// ([`LinearParams::guard_slivers`]), and more passes (30) and attempts per tet (6).
-    /// A fill starts far worse than a front's mesh (on OpenSCAD's children.stl 27,414 of
-    /// its 37,631 tets are below the goal), and the default bounds ran out with nearly
-    /// flat interior tets left, which then fail P2 certification (children: 21
-    /// elements; example022: 3). With these bounds both certify, at about 1.5x the
-    /// stage's time (children's whole run 18 -> 30 s); 16 passes and 5 attempts left
-    /// children 2 elements short.
+    /// ([`LinearParams::guard_slivers`]), then passes aimed at the nearly flat tets only
+    /// ([`LinearParams::flat_skewness`] 0.95, a minimum dihedral angle below about 3.5°).
+    /// A fill starts far worse than a front's mesh (most of its tets are below the goal):
+    /// the default attempt budget runs out on tets that are merely poor and leaves nearly
+    /// flat ones, which then fail P2 certification. More passes and attempts for every
+    /// poor tet also removed them, at twice to three times this stage's time (the
+    /// commit history has the figures).
     pub fn for_whole_fill() -> Self {
         LinearParams {
-            max_passes: 30,
-            max_attempts_per_tet: 6.0,
             guard_slivers: true,
+            flat_skewness: Some(0.95),
             ..LinearParams::default()
         }
     }
@@ -230,6 +234,15 @@ pub fn improve_linear_known(
             &mut order,
             &mut failed,
         );
+    }
+    if let Some(flat) = prm.flat_skewness {
+        let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
+        let flat = LinearParams {
+            goal_skewness: flat,
+            max_attempts_per_tet: spent + 1.0,
+            ..prm.clone()
+        };
+        run_passes(&mut m, &flat, &mut sc, &mut st, &mut order, &mut failed);
     }
     let (w1, b1) = census(&m, goal);
     let (pts, tets) = m.into_parts();
