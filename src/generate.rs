@@ -227,15 +227,17 @@ fn generate_inner(
             continue;
         }
         let (mut mesh, mut conf, mut bad) = (mesh, conf, bad);
-        if conf.is_ok() && !bad.is_empty() && surface.chords_allowed() {
+        if conf.is_ok() && !bad.is_empty() {
             let t = Instant::now();
-            let n_surf = surface.nodes().len();
-            ostats.chords = straighten_uncertified(&mut mesh, n_surf, &mut bad, |m| {
+            let (n_surf, chords) = (surface.nodes().len(), surface.chords_allowed());
+            let redo = |m: &mut TetMesh| {
                 if opts.optimize {
                     pool.install(|| optimize_high_order(m, &bnd, &high_order_params(opts)));
                 }
                 pool.install(|| uncertified(m))
-            });
+            };
+            [ostats.chords, ostats.interior_chords] =
+                straighten_uncertified(&mut mesh, n_surf, chords, &mut bad, redo);
             if ostats.chords > 0 {
                 conf = pool.install(|| check::check_conformity(&mesh));
             }
@@ -296,45 +298,48 @@ fn generate_inner(
 /// Rounds of [`straighten_uncertified`].
 const CHORD_ROUNDS: usize = 4;
 
-/// Where elements are left uncertified on a surface curved from a linear one
-/// ([`Surface::chords_allowed`]), put the mid nodes of their boundary edges back on the
-/// chords, the input's own straight edges, and optimize and certify again (`redo`, which
-/// returns the elements still uncertified into `bad`); a few rounds, while some are left
-/// and have curved boundary edges. A curved boundary edge can bulge past an interior
-/// vertex that a thin pocket of the surface leaves close to it (the whole fill's tets
-/// on OpenSCAD's example004 and example010: apex heights of 1e-4 to 3e-3 of the edge
-/// length under a bulge of 0.3-1.7%); no placement of the interior nodes certifies
-/// such an element, while with the chord it is a valid straight-sided one. Returns the
-/// number of edges straightened.
+/// Where elements are left uncertified, put the mid nodes of their edges back on the
+/// chords and optimize and certify again (`redo`, which returns the elements still
+/// uncertified into `bad`); a few rounds, while some are left with curved edges. An
+/// interior edge always may; a boundary edge only on a surface curved from a linear one
+/// (`chords`: [`Surface::chords_allowed`]), whose own edges are the straight ones.
+///
+/// A thin pocket of the surface can leave an interior vertex closer to a curved boundary
+/// edge than the edge bulges (the whole fill's tets on OpenSCAD's example004 and
+/// example010), and no placement of the interior nodes certifies such an element; the
+/// high-order stage's attempts at it leave its interior edges bent too, which inverts a
+/// nearly flat tet. Straight-sided, a tet of positive volume is valid. Returns the
+/// numbers of boundary and interior edges straightened.
 fn straighten_uncertified(
     mesh: &mut TetMesh,
     n_surf: usize,
+    chords: bool,
     bad: &mut Vec<usize>,
     mut redo: impl FnMut(&mut TetMesh) -> Vec<usize>,
-) -> usize {
-    let mut straightened = 0;
+) -> [usize; 2] {
+    let mut straightened = [0, 0];
     for _ in 0..CHORD_ROUNDS {
-        let mut chords = Vec::new();
+        // (mid node, its chord midpoint, boundary?)
+        let mut moves = Vec::new();
         for &e in bad.iter() {
             let t = mesh.tets[e];
             for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
                 let m = t[4 + k] as usize;
                 // Only a boundary edge's mid node is a surface node.
-                if m < n_surf {
-                    let c = mid(mesh.nodes[t[*i] as usize], mesh.nodes[t[*j] as usize]);
-                    if mesh.nodes[m] != c {
-                        chords.push((m, c));
-                    }
+                let boundary = m < n_surf;
+                let c = mid(mesh.nodes[t[*i] as usize], mesh.nodes[t[*j] as usize]);
+                if (chords || !boundary) && mesh.nodes[m] != c {
+                    moves.push((m, c, boundary));
                 }
             }
         }
-        if chords.is_empty() {
+        if moves.is_empty() {
             break;
         }
-        for (m, c) in chords {
+        for (m, c, boundary) in moves {
             if mesh.nodes[m] != c {
                 mesh.nodes[m] = c;
-                straightened += 1;
+                straightened[usize::from(!boundary)] += 1;
             }
         }
         *bad = redo(mesh);
@@ -512,12 +517,58 @@ mod tests {
         };
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0], "the bulging element must start uncertified");
-        let n = straighten_uncertified(&mut mesh, 6, &mut bad, |m| uncertified(m));
-        assert_eq!(n, 1, "only the curved boundary edge is straightened");
+        let n = straighten_uncertified(&mut mesh, 6, true, &mut bad, |m| uncertified(m));
+        assert_eq!(n, [1, 0], "only the curved boundary edge is straightened");
         assert!(bad.is_empty(), "{bad:?}");
         assert_eq!(mesh.nodes[3], mid(a, b));
         // Interior mid nodes are not the surface's: never touched.
         assert_eq!(mesh.nodes[7], mid(d, a));
+    }
+
+    /// A bent interior edge on a thin tet is straightened on any surface; a curved
+    /// boundary edge only where the surface allows chords.
+    #[test]
+    fn a_bent_interior_edge_is_straightened_a_boundary_one_only_with_chords() {
+        let (a, b, c, d) = (
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.3, 0.3, 0.01],
+        );
+        let tet = |ab: P3, da: P3| TetMesh {
+            nodes: vec![
+                a,
+                b,
+                c,
+                ab,
+                mid(b, c),
+                mid(c, a),
+                d,
+                da,
+                mid(d, b),
+                mid(d, c),
+            ],
+            tets: vec![[0, 1, 2, 6, 3, 4, 5, 7, 9, 8]],
+            ..TetMesh::default()
+        };
+        // The interior edge DA bent through the base's plane.
+        let bent = [0.15, 0.15, -0.02];
+        let mut mesh = tet(mid(a, b), bent);
+        let mut bad = uncertified(&mesh);
+        assert_eq!(bad, vec![0], "the bent element must start uncertified");
+        let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m| uncertified(m));
+        assert_eq!(n, [0, 1]);
+        assert!(bad.is_empty(), "{bad:?}");
+        assert_eq!(mesh.nodes[7], mid(d, a));
+        // A curved boundary edge stays as it is without chords.
+        let bulge = [0.5, 0.0, 0.05];
+        let mut mesh = tet(bulge, mid(d, a));
+        let mut bad = uncertified(&mesh);
+        assert_eq!(bad, vec![0]);
+        let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m| uncertified(m));
+        assert_eq!(n, [0, 0]);
+        assert_eq!(bad, vec![0]);
+        assert_eq!(mesh.nodes[3], bulge);
     }
 
     fn mc_blob(smooth_iterations: u32) -> Surface {

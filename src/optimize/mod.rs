@@ -40,4 +40,6 @@ pub struct OptimizeStats {
     /// Boundary edges put back on their chords (a surface curved from a linear one)
     /// where curved elements could not be certified.
     pub chords: usize,
+    /// Interior edges put back on their chords where elements could not be certified.
+    pub interior_chords: usize,
 }
