@@ -486,83 +486,66 @@ mod tests {
     use super::*;
     use crate::surface::curve::CurveOptions;
 
+    /// Corners of a thin tet: base ABC on the surface (z = 0), interior apex D at height
+    /// 0.01.
+    const A: P3 = [0.0, 0.0, 0.0];
+    const B: P3 = [1.0, 0.0, 0.0];
+    const C: P3 = [0.0, 1.0, 0.0];
+    const D: P3 = [0.3, 0.3, 0.01];
+
+    /// The thin tet with mid nodes `ab` on its boundary edge AB and `da` on its interior
+    /// edge DA, the others on their chords; nodes 0-5 are the surface's (corners, then
+    /// mid nodes), Gmsh order (edges 01 12 20 30 32 31).
+    fn thin_tet(ab: P3, da: P3) -> TetMesh {
+        TetMesh {
+            nodes: vec![
+                A,
+                B,
+                C,
+                ab,
+                mid(B, C),
+                mid(C, A),
+                D,
+                da,
+                mid(D, B),
+                mid(D, C),
+            ],
+            tets: vec![[0, 1, 2, 6, 3, 4, 5, 7, 9, 8]],
+            ..TetMesh::default()
+        }
+    }
+
     /// A boundary edge bulging past a low interior apex: the element cannot be certified
     /// curved; with the edge back on its chord it is a valid straight-sided one.
     #[test]
     fn a_boundary_edge_bulging_past_the_apex_is_straightened() {
-        let (a, b, c, d) = (
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.3, 0.3, 0.01],
-        );
-        let nodes = vec![
-            a,
-            b,
-            c,
-            // The surface's mid nodes (AB bulges toward the apex, 5x its height).
-            [0.5, 0.0, 0.05],
-            mid(b, c),
-            mid(c, a),
-            d,
-            mid(d, a),
-            mid(d, b),
-            mid(d, c),
-        ];
-        // Gmsh order: edges 01 12 20 30 32 31.
-        let mut mesh = TetMesh {
-            nodes,
-            tets: vec![[0, 1, 2, 6, 3, 4, 5, 7, 9, 8]],
-            ..TetMesh::default()
-        };
+        // AB bulges toward the apex, 5x its height.
+        let mut mesh = thin_tet([0.5, 0.0, 0.05], mid(D, A));
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0], "the bulging element must start uncertified");
         let n = straighten_uncertified(&mut mesh, 6, true, &mut bad, |m| uncertified(m));
         assert_eq!(n, [1, 0], "only the curved boundary edge is straightened");
         assert!(bad.is_empty(), "{bad:?}");
-        assert_eq!(mesh.nodes[3], mid(a, b));
-        // Interior mid nodes are not the surface's: never touched.
-        assert_eq!(mesh.nodes[7], mid(d, a));
+        assert_eq!(mesh.nodes[3], mid(A, B));
+        assert_eq!(mesh.nodes[7], mid(D, A));
     }
 
     /// A bent interior edge on a thin tet is straightened on any surface; a curved
     /// boundary edge only where the surface allows chords.
     #[test]
     fn a_bent_interior_edge_is_straightened_a_boundary_one_only_with_chords() {
-        let (a, b, c, d) = (
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.3, 0.3, 0.01],
-        );
-        let tet = |ab: P3, da: P3| TetMesh {
-            nodes: vec![
-                a,
-                b,
-                c,
-                ab,
-                mid(b, c),
-                mid(c, a),
-                d,
-                da,
-                mid(d, b),
-                mid(d, c),
-            ],
-            tets: vec![[0, 1, 2, 6, 3, 4, 5, 7, 9, 8]],
-            ..TetMesh::default()
-        };
         // The interior edge DA bent through the base's plane.
         let bent = [0.15, 0.15, -0.02];
-        let mut mesh = tet(mid(a, b), bent);
+        let mut mesh = thin_tet(mid(A, B), bent);
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0], "the bent element must start uncertified");
         let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m| uncertified(m));
         assert_eq!(n, [0, 1]);
         assert!(bad.is_empty(), "{bad:?}");
-        assert_eq!(mesh.nodes[7], mid(d, a));
+        assert_eq!(mesh.nodes[7], mid(D, A));
         // A curved boundary edge stays as it is without chords.
         let bulge = [0.5, 0.0, 0.05];
-        let mut mesh = tet(bulge, mid(d, a));
+        let mut mesh = thin_tet(bulge, mid(D, A));
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0]);
         let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m| uncertified(m));
