@@ -242,6 +242,12 @@ fn generate_inner(
                 conf = pool.install(|| check::check_conformity(&mesh));
             }
             times.optimize += t.elapsed().as_secs_f64();
+            // Tests only: a fault on every attempt is put back after the repair above,
+            // so that it still reaches the final check.
+            if fault_persists() {
+                mesh = inject_fault(mesh, surface.nodes().len(), false);
+                bad = pool.install(|| uncertified(&mesh));
+            }
         }
         break (front.stats, mesh, ostats, conf, bad);
     };
@@ -408,6 +414,20 @@ pub const INJECT_FAULT_ENV: &str = "CURVETET_INJECT_INVALID_MESH";
 #[cfg(not(feature = "fault-injection"))]
 fn inject_fault(mesh: TetMesh, _surface_nodes: usize, _first_attempt: bool) -> TetMesh {
     mesh
+}
+
+/// Without the `fault-injection` feature: no fault.
+#[cfg(not(feature = "fault-injection"))]
+fn fault_persists() -> bool {
+    false
+}
+
+/// Whether [`INJECT_FAULT_ENV`] asks for a Jacobian fault on every attempt (which
+/// [`straighten_uncertified`] would otherwise repair before the final check).
+#[cfg(feature = "fault-injection")]
+fn fault_persists() -> bool {
+    std::env::var(INJECT_FAULT_ENV)
+        .is_ok_and(|s| s.split_once(':').map_or(s.as_str(), |x| x.0) == "jacobian")
 }
 
 /// The fault [`INJECT_FAULT_ENV`] asks for, if any.
