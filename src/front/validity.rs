@@ -60,8 +60,7 @@ pub struct Verdict {
     pub closing_on_boundary: [bool; 6],
 }
 
-/// Smallest 6 x volume / (longest edge)^3 of a tet the front creates.
-pub const MIN_RELATIVE_VOLUME: f64 = 1e-12;
+pub use crate::geom::tet_quality::MIN_RELATIVE_VOLUME;
 
 /// Id the caller gives a candidate's apex when it is a new point.
 pub const NEW_POINT: u32 = u32::MAX - 1;
@@ -94,11 +93,7 @@ pub fn check(
     }
     // Numerically degenerate (flatter than f64 resolves relative to its size): its
     // Jacobian could not be certified, so it is never created.
-    let l2 = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
-        .iter()
-        .map(|&(i, j)| dist2(tp[i], tp[j]))
-        .fold(0.0, f64::max);
-    if tet_det(tp[0], tp[1], tp[2], tp[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt() {
+    if crate::geom::tet_quality::numerically_flat(&tp) {
         return Err(Conflict::Degenerate);
     }
     // T's outward face planes: every nearby front vertex is tested against them.

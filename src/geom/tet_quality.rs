@@ -28,6 +28,22 @@ pub const DEFAULT_SJ_REL_TOL: f64 = 1e-3;
 /// Order of the lattice [`scaled_jacobian_sampled`] samples (84 points, corners included).
 pub const SAMPLE_ORDER: usize = 6;
 
+/// Smallest 6 x volume / (longest edge)^3 of a tet the front and the linear stage make:
+/// below it a tet is flatter than f64 resolves relative to its size ([`numerically_flat`]).
+pub const MIN_RELATIVE_VOLUME: f64 = 1e-12;
+
+/// Is the straight tet `c` numerically flat: 6 x its volume at most
+/// [`MIN_RELATIVE_VOLUME`] times its longest edge cubed? Such a tet can be positive by
+/// the exact predicate, but its Jacobian cannot be certified.
+#[inline]
+pub fn numerically_flat(c: &[P3; 4]) -> bool {
+    let l2 = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+        .iter()
+        .map(|&(i, j)| super::vec3::dist2(c[i], c[j]))
+        .fold(0.0, f64::max);
+    super::vec3::tet_det(c[0], c[1], c[2], c[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt()
+}
+
 /// Outward (for a positive tet) normals of the faces opposite corners 0, 1, 2, 3.
 #[inline]
 fn face_normals(c: &[P3; 4]) -> [P3; 4] {

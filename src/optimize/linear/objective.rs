@@ -11,7 +11,8 @@ use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds,
 use crate::geom::predicates::orient3d;
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::tet_quality::{
-    dihedral_at_edge, dihedral_extremes, skewness_from_extremes, EQUIANGULAR_DIHEDRAL_DEG,
+    dihedral_at_edge, dihedral_extremes, numerically_flat, skewness_from_extremes,
+    EQUIANGULAR_DIHEDRAL_DEG,
 };
 use crate::geom::vec3::P3;
 use crate::optimize::dual::{dcross, ddot, dsub, D3, DP};
@@ -55,7 +56,9 @@ impl ElementQuality {
         c: &[P3; 4],
         floor: f64,
     ) -> f64 {
-        if orient3d(c[0], c[1], c[2], c[3]) <= 0 {
+        // A numerically flat tet scores as an inverted one: its Jacobian cannot be
+        // certified, so the stage never makes one and works to remove those it is given.
+        if orient3d(c[0], c[1], c[2], c[3]) <= 0 || numerically_flat(c) {
             return f64::NEG_INFINITY;
         }
         let (lo, hi) = dihedral_extremes(c);
@@ -187,6 +190,32 @@ pub(super) fn skew_pieces(c: &[P3; 4], k: usize) -> [D3; 12] {
 mod tests {
     use super::*;
     use crate::geom::tet_quality::{dihedral_angles, equiangular_skewness};
+
+    /// A tet positive by the exact predicate but flatter than f64 resolves scores as an
+    /// inverted one; a thin one that is not still has its (poor) quality.
+    #[test]
+    fn a_numerically_flat_tet_scores_as_an_inverted_one() {
+        use crate::geom::predicates::orient3d;
+        let c = crate::optimize::testmesh::cube(1, 0.0);
+        let bnd = c.boundary();
+        let tet = |h: f64| -> [P3; 4] {
+            [
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.3, 0.3, h],
+            ]
+        };
+        let v = [100, 101, 102, 103];
+        let flat = tet(1e-14);
+        assert!(orient3d(flat[0], flat[1], flat[2], flat[3]) > 0);
+        assert_eq!(
+            ElementQuality.eval(&bnd, &c.pts, v, &flat),
+            f64::NEG_INFINITY
+        );
+        let thin = ElementQuality.eval(&bnd, &c.pts, v, &tet(1e-6));
+        assert!(thin.is_finite() && thin >= 0.0, "{thin}");
+    }
 
     #[test]
     fn eval_above_agrees_with_eval_above_the_floor() {
