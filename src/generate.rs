@@ -300,7 +300,6 @@ fn generate_inner(
     })
 }
 
-/// The high-order stage's tuning for `opts` ([`Options::thorough`]).
 /// Rounds of [`straighten_uncertified`].
 const CHORD_ROUNDS: usize = 4;
 
@@ -356,6 +355,7 @@ fn straighten_uncertified(
     straightened
 }
 
+/// The high-order stage's tuning for `opts` ([`Options::thorough`]).
 fn high_order_params(opts: &Options) -> HighOrderParams {
     if opts.thorough {
         HighOrderParams::thorough()
