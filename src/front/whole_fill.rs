@@ -139,21 +139,22 @@ fn interior_points(
     if ext.is_nan() || ext <= 0.0 {
         return Err("the surface has no extent".into());
     }
-    let tri_pts = |t: &[u32; 6]| [0, 1, 2].map(|k| corner_pts[local(t[k]) as usize]);
+    // The corner triangles' points, looked up once: the clearance test below reads
+    // them for every candidate point near a triangle.
+    let tris: Vec<[P3; 3]> = surf_tris
+        .iter()
+        .map(|t| [0, 1, 2].map(|k| corner_pts[local(t[k]) as usize]))
+        .collect();
     // The grid's cell: twice the mean edge (one edge per triangle), as the front's.
     let mut mean_edge = 0.0;
-    for t in surf_tris {
-        let p = tri_pts(t);
+    for p in &tris {
         mean_edge += crate::geom::vec3::dist(p[0], p[1]);
     }
     mean_edge /= surf_tris.len().max(1) as f64;
     let mut grid = FaceGrid::new(bounds, 2.0 * mean_edge, (16 * surf_tris.len()).max(1 << 16));
-    let balls: Vec<Vec<(P3, f64)>> = surf_tris
-        .iter()
-        .map(|t| protecting_balls(tri_pts(t)))
-        .collect();
-    for (i, t) in surf_tris.iter().enumerate() {
-        let mut b = Aabb::of(&tri_pts(t));
+    let balls: Vec<Vec<(P3, f64)>> = tris.iter().map(|&t| protecting_balls(t)).collect();
+    for (i, t) in tris.iter().enumerate() {
+        let mut b = Aabb::of(t);
         for &(c, r2) in &balls[i] {
             let r = r2.sqrt();
             b.lo = std::array::from_fn(|d| b.lo[d].min(c[d] - r));
@@ -205,7 +206,7 @@ fn interior_points(
         };
         grid.query(&b, |_| true, &mut near);
         let clear = near.iter().all(|&i| {
-            let q = tri_pts(&surf_tris[i as usize]);
+            let q = tris[i as usize];
             point_triangle_dist2(p, q[0], q[1], q[2]) >= r * r
                 && balls[i as usize].iter().all(|&(c, r2)| dist2(p, c) >= r2)
         });
@@ -215,7 +216,6 @@ fn interior_points(
     }
     // Which are inside: those outside cost the Delaunay insertion and the boundary
     // recovery their tets, then are dropped with them.
-    let tris: Vec<[P3; 3]> = surf_tris.iter().map(tri_pts).collect();
     let inside = crate::surface::inside::enclosed(&tris, &keep);
     Ok(keep.into_iter().zip(inside).collect())
 }

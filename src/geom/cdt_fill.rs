@@ -26,7 +26,8 @@ use super::delaunay::{closes_up, sorted2, sorted3, Delaunay, FACES, NONE};
 use super::predicates::{orient3d, projection_of};
 use super::tet_quality::dihedral_extremes;
 use super::vec3::{axpy, dist, dot, norm, sub, tet_det, tri_normal, P3};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
+use std::collections::BTreeMap;
 
 /// A filled region: the input points then the new interior points, and positive tets.
 pub(crate) struct Filled {
@@ -151,9 +152,9 @@ impl<'a> Cdt<'a> {
         Ok(Cdt {
             dt,
             faces,
-            chains: HashMap::new(),
+            chains: HashMap::default(),
             inner: vec![Vec::new(); faces.len()],
-            parent: HashMap::new(),
+            parent: HashMap::default(),
             split,
             grown: 0,
             tiny: 0,
@@ -330,8 +331,8 @@ impl<'a> Cdt<'a> {
     fn recover_face(&mut self, i: usize) -> Result<(), &'static str> {
         let f = self.faces[i];
         let fp = f.map(|v| self.dt.p(v));
-        let mut on: HashSet<u32> = HashSet::new();
-        let mut rim: HashSet<[u32; 2]> = HashSet::new();
+        let mut on: HashSet<u32> = HashSet::default();
+        let mut rim: HashSet<[u32; 2]> = HashSet::default();
         for k in 0..3 {
             let ch = self.chain(f[k], f[(k + 1) % 3]);
             for w in ch.windows(2) {
@@ -416,7 +417,7 @@ impl<'a> Cdt<'a> {
         let mut near: Vec<u32> = on.iter().flat_map(|&v| self.dt.star(v)).collect();
         near.sort_unstable();
         near.dedup();
-        let mut subs: HashSet<[u32; 3]> = HashSet::new();
+        let mut subs: HashSet<[u32; 3]> = HashSet::default();
         for &t in &near {
             let tv = self.dt.tets[t as usize];
             if tv.iter().all(|v| on.contains(v)) {
@@ -429,7 +430,7 @@ impl<'a> Cdt<'a> {
                 }
             }
         }
-        let mut uses: HashMap<[u32; 2], u32> = HashMap::new();
+        let mut uses: HashMap<[u32; 2], u32> = HashMap::default();
         for g in &subs {
             for k in 0..3 {
                 *uses.entry(sorted2(g[k], g[(k + 1) % 3])).or_insert(0) += 1;
@@ -537,13 +538,13 @@ impl<'a> Cdt<'a> {
         let first = self.dt.n as u32 + 4;
         let last = self.dt.pts.len() as u32;
         // How many input faces use each input edge (2, or 4 where two pockets touch).
-        let mut edge_faces: HashMap<[u32; 2], usize> = HashMap::new();
+        let mut edge_faces: HashMap<[u32; 2], usize> = HashMap::default();
         for f in self.faces {
             for k in 0..3 {
                 *edge_faces.entry(sorted2(f[k], f[(k + 1) % 3])).or_insert(0) += 1;
             }
         }
-        let mut on_edge: HashMap<u32, usize> = HashMap::new();
+        let mut on_edge: HashMap<u32, usize> = HashMap::default();
         for (e, ch) in &self.chains {
             for &v in &ch[1..ch.len() - 1] {
                 on_edge.insert(v, edge_faces.get(e).copied().unwrap_or(2));
@@ -588,7 +589,7 @@ impl<'a> Cdt<'a> {
     /// are left (its new star there has no kernel).
     fn remove_one(&mut self, s: u32, pockets: usize) -> Result<usize, &'static str> {
         let mut left = pockets;
-        let mut seen: HashSet<u32> = HashSet::new();
+        let mut seen: HashSet<u32> = HashSet::default();
         let mut failed = 0;
         while left > failed {
             let star = self.dt.star(s);
@@ -1063,10 +1064,10 @@ impl<'a> Cdt<'a> {
     fn result(&self) -> Result<Filled, &'static str> {
         let n = self.dt.n;
         let first = n as u32 + 4;
-        let mut map: HashMap<u32, u32> = HashMap::new();
+        let mut map: HashMap<u32, u32> = HashMap::default();
         let mut pts: Vec<P3> = self.dt.pts[..n].to_vec();
         let mut tets = Vec::new();
-        let mut bound: HashSet<[u32; 3]> = HashSet::new();
+        let mut bound: HashSet<[u32; 3]> = HashSet::default();
         for t in 0..self.dt.tets.len() {
             if !self.dt.alive[t] {
                 continue;
@@ -1322,7 +1323,7 @@ mod tests {
         let r = fill(pts, &faces, Split::AtCrossing, None).map_err(|e| e.to_string())?;
         assert_eq!(&r.pts[..pts.len()], pts);
         let mut vol = 0.0;
-        let mut uses: HashMap<[u32; 3], i32> = HashMap::new();
+        let mut uses: HashMap<[u32; 3], i32> = HashMap::default();
         for t in &r.tets {
             let p = t.map(|v| r.pts[v as usize]);
             assert!(orient3d(p[0], p[1], p[2], p[3]) > 0);

@@ -12,7 +12,7 @@
 
 use super::predicates::orient3d;
 use super::vec3::P3;
-use std::collections::{HashMap, HashSet};
+use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 
 /// No tet (a hull face's outer neighbour).
 pub(crate) const NONE: u32 = u32::MAX;
@@ -120,11 +120,11 @@ impl Delaunay {
             adj: vec![[NONE; 4]],
             alive: vec![true],
             vt,
-            on_line: HashMap::new(),
-            on_face: HashMap::new(),
-            edge_faces: HashMap::new(),
-            fixed_edges: HashSet::new(),
-            fixed_faces: HashSet::new(),
+            on_line: HashMap::default(),
+            on_face: HashMap::default(),
+            edge_faces: HashMap::default(),
+            fixed_edges: HashSet::default(),
+            fixed_faces: HashSet::default(),
             last: 0,
         };
         for i in 0..n as u32 {
@@ -198,7 +198,7 @@ impl Delaunay {
         // (which contains q, so its sphere does unless q is on it: then it is still
         // removed, as q lies in it).
         let mut cavity = vec![start];
-        let mut in_cav: HashMap<u32, ()> = HashMap::new();
+        let mut in_cav: HashMap<u32, ()> = HashMap::default();
         in_cav.insert(start, ());
         let mut k = 0;
         while k < cavity.len() {
@@ -257,8 +257,8 @@ impl Delaunay {
     /// no outer face of `old` gets no neighbour (the fill's boundary changes that way when
     /// it moves a Steiner point off a constraint face).
     pub(crate) fn replace(&mut self, old: &[u32], new: &[[u32; 4]]) -> Vec<u32> {
-        let mut outer: HashMap<[u32; 3], (u32, usize)> = HashMap::new();
-        let olds: std::collections::HashSet<u32> = old.iter().copied().collect();
+        let mut outer: HashMap<[u32; 3], (u32, usize)> = HashMap::default();
+        let olds: HashSet<u32> = old.iter().copied().collect();
         for &t in old {
             let v = self.tets[t as usize];
             for (k, f) in FACES.iter().enumerate() {
@@ -278,7 +278,7 @@ impl Delaunay {
             }
             self.alive[t as usize] = false;
         }
-        let mut inner: HashMap<[u32; 3], (u32, usize)> = HashMap::new();
+        let mut inner: HashMap<[u32; 3], (u32, usize)> = HashMap::default();
         let mut ids = Vec::with_capacity(new.len());
         for &v in new {
             let nt = self.tets.len() as u32;
@@ -324,6 +324,11 @@ impl Delaunay {
     /// The input points an added point stands for (itself for an input point), for
     /// every point of `vs`, sorted; and whether any of `vs` is an added point.
     fn supports(&self, vs: &[u32]) -> (Vec<u32>, bool) {
+        // Only points after the input and the four far points can be added ones: most
+        // tets tested have none, and skip the lookups.
+        if vs.iter().all(|&v| (v as usize) < self.n + 4) {
+            return (Vec::new(), false);
+        }
         let mut sup: Vec<u32> = Vec::with_capacity(3 * vs.len());
         let mut added = false;
         for &v in vs {
@@ -485,41 +490,41 @@ impl Delaunay {
         if !(links[j].contains(&ring[0]) && links[j].contains(&ring[n - 1])) {
             return false;
         }
-        for apex in 0..n {
+        'fans: for apex in 0..n {
             let mut new = Vec::with_capacity(2 * (n - 2));
             for k in 1..n - 1 {
                 let a = ring[apex];
                 let b = ring[(apex + k) % n];
                 let c = ring[(apex + k + 1) % n];
+                // x and y on opposite sides of each fan triangle: the cheap test first,
+                // before the construction lookups of `valid_new` (edge recovery on CAD
+                // parts spends most of its time here).
+                let (pa, pb, pc) = (self.p(a), self.p(b), self.p(c));
+                if orient3d(pa, pb, pc, self.p(x)) != -orient3d(pa, pb, pc, self.p(y)) {
+                    continue 'fans;
+                }
                 for top in [x, y] {
                     let mut t = [a, b, c, top];
                     if !self.positive(t) {
                         t.swap(0, 1);
                     }
+                    if !self.valid_new(t) {
+                        continue 'fans;
+                    }
                     new.push(t);
                 }
             }
-            if new.iter().all(|&t| self.valid_new(t))
-                && (1..n - 1).all(|k| {
-                    // x and y on opposite sides of each fan triangle.
-                    let a = self.p(ring[apex]);
-                    let b = self.p(ring[(apex + k) % n]);
-                    let c = self.p(ring[(apex + k + 1) % n]);
-                    orient3d(a, b, c, self.p(x)) == -orient3d(a, b, c, self.p(y))
-                })
-            {
-                // Volumes must match the old ones (no overlap): check exactly by sign sum
-                // is not possible; compare floating volumes as a guard.
-                let vol = |t: &[u32; 4]| {
-                    let p = t.map(|v| self.p(v));
-                    super::vec3::tet_det(p[0], p[1], p[2], p[3])
-                };
-                let old: f64 = around.iter().map(|&t| vol(&self.tets[t as usize])).sum();
-                let newv: f64 = new.iter().map(vol).sum();
-                if (old - newv).abs() <= 1e-9 * old.abs() {
-                    self.replace(around, &new);
-                    return true;
-                }
+            // Volumes must match the old ones (no overlap): check exactly by sign sum
+            // is not possible; compare floating volumes as a guard.
+            let vol = |t: &[u32; 4]| {
+                let p = t.map(|v| self.p(v));
+                super::vec3::tet_det(p[0], p[1], p[2], p[3])
+            };
+            let old: f64 = around.iter().map(|&t| vol(&self.tets[t as usize])).sum();
+            let newv: f64 = new.iter().map(vol).sum();
+            if (old - newv).abs() <= 1e-9 * old.abs() {
+                self.replace(around, &new);
+                return true;
             }
         }
         false
@@ -543,7 +548,7 @@ impl Delaunay {
     /// cylinder's cap of many facets) gives a point thousands of tets.
     pub(crate) fn walk_around(&self, v: u32, t0: u32, keep: impl Fn(u32) -> bool) -> Vec<u32> {
         let mut out = vec![t0];
-        let mut seen: HashSet<u32> = HashSet::from([t0]);
+        let mut seen: HashSet<u32> = HashSet::from_iter([t0]);
         let mut k = 0;
         while k < out.len() {
             let t = out[k];
@@ -674,18 +679,20 @@ impl Delaunay {
             (0..4).all(|j| dt.positive(new_tet(dt, t, j)) || on_face(dt, t, j))
         };
         let mut cav = vec![start];
-        let mut in_cav: HashSet<u32> = HashSet::from([start]);
+        let mut in_cav: HashSet<u32> = HashSet::from_iter([start]);
         let mut k = 0;
         while k < cav.len() {
             let t = cav[k];
             k += 1;
+            let mut holds_p = None;
             for j in 0..4 {
                 let nb = self.adj[t as usize][j];
                 if nb == NONE || in_cav.contains(&nb) || fixed_face(self, t, j) {
                     continue;
                 }
                 // Every tet holding p, and those the sphere test takes.
-                if (holds(self, t) && on_face(self, t, j)) || self.in_sphere(nb, p) > 0 {
+                let holds_p = *holds_p.get_or_insert_with(|| holds(self, t));
+                if (holds_p && on_face(self, t, j)) || self.in_sphere(nb, p) > 0 {
                     in_cav.insert(nb);
                     cav.push(nb);
                 }
@@ -697,8 +704,8 @@ impl Delaunay {
         };
         loop {
             let mut out: Vec<u32> = Vec::new();
-            let mut bound_edges: HashSet<[u32; 2]> = HashSet::new();
-            let mut bound_pts: HashSet<u32> = HashSet::new();
+            let mut bound_edges: HashSet<[u32; 2]> = HashSet::default();
+            let mut bound_pts: HashSet<u32> = HashSet::default();
             for &t in &cav {
                 for j in 0..4 {
                     let nb = self.adj[t as usize][j];
@@ -939,7 +946,7 @@ impl Delaunay {
 /// Whether oriented triangles close up: every edge on two of them, once each way (the
 /// faces of a cavity, seen from the point that fills it).
 pub(crate) fn closes_up(tris: impl Iterator<Item = [u32; 3]>) -> bool {
-    let mut edges: HashMap<[u32; 2], i32> = HashMap::new();
+    let mut edges: HashMap<[u32; 2], i32> = HashMap::default();
     for f in tris {
         for k in 0..3 {
             let (a, b) = (f[k], f[(k + 1) % 3]);
