@@ -37,9 +37,9 @@ pub const MIN_RELATIVE_VOLUME: f64 = 1e-12;
 /// the exact predicate, but its Jacobian cannot be certified.
 #[inline]
 pub fn numerically_flat(c: &[P3; 4]) -> bool {
-    let l2 = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    let l2 = super::shape::TET10_EDGES
         .iter()
-        .map(|&(i, j)| super::vec3::dist2(c[i], c[j]))
+        .map(|&[i, j]| super::vec3::dist2(c[i], c[j]))
         .fold(0.0, f64::max);
     super::vec3::tet_det(c[0], c[1], c[2], c[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt()
 }
