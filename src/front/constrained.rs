@@ -4,7 +4,7 @@
 
 use super::validity::{self, FaceRef, TET_OUT_FACES};
 use super::{key3, Mesher};
-use crate::geom::cdt_fill;
+use crate::geom::cdt_fill::{self, Patience};
 use crate::geom::vec3::{tet_det, P3};
 
 /// Largest cavity (front faces) handed to the fill.
@@ -22,7 +22,8 @@ impl Mesher<'_> {
             .iter()
             .map(|&f| self.faces[f as usize].v.map(local))
             .collect();
-        let Ok(filled) = cdt_fill::fill(&pts, &faces, cdt_fill::Split::AtCrossing, None) else {
+        let split = cdt_fill::Split::AtCrossing;
+        let Ok(filled) = cdt_fill::fill(&pts, &faces, split, None, Patience::Exhaustive) else {
             return false;
         };
         // Global ids: the cavity's vertices, then the new points (not yet added).

@@ -13,13 +13,14 @@
 //! edges, hundreds). Points outside the surface (exact ray parity) are left out too;
 //! the fill is tried with them only where it fails without them.
 //!
-//! The fill places Steiner points at segment crossings; where that fails it is run
-//! again halving the segments ([`Split`]).
+//! The fill places Steiner points at segment crossings; where that fails, or its first
+//! round of moving them off the surface leaves many on it ([`Patience`]), it is run again
+//! halving the segments ([`Split`]).
 
 use super::grid::{Aabb, FaceGrid};
 use super::size::SizeField;
 use super::{FrontOutput, FrontStats};
-use crate::geom::cdt_fill::{self, Split};
+use crate::geom::cdt_fill::{self, Patience, Split};
 use crate::geom::distance::point_triangle_dist2;
 use crate::geom::vec3::{axpy, cross, dist2, dot, mid, scale, sub, P3};
 use std::collections::HashSet;
@@ -44,19 +45,13 @@ pub(crate) fn whole_fill(
     surf_tris: &[[u32; 6]],
     size: &SizeField,
 ) -> Result<FrontOutput, String> {
-    // The corner nodes, in local numbering.
-    let mut corners: Vec<u32> = surf_tris.iter().flat_map(|t| [t[0], t[1], t[2]]).collect();
-    corners.sort_unstable();
-    corners.dedup();
-    let local = |v: u32| corners.binary_search(&v).map_or(u32::MAX, |i| i as u32);
-    let pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
+    let FillInput {
+        corners,
+        pts,
+        interior,
+        faces,
+    } = fill_input(surf_nodes, surf_tris, size)?;
     let n_corners = pts.len();
-    let interior = interior_points(&pts, surf_tris, &local, size)?;
-    // The fill wants the region on each face's positive side: the outward input reversed.
-    let faces: Vec<[u32; 3]> = surf_tris
-        .iter()
-        .map(|t| [local(t[0]), local(t[2]), local(t[1])])
-        .collect();
     // Thin tets on the surface get a point above it, at most a size high.
     let height = |p: P3| size.at(p);
     // Steiner points at crossings first; halving where crossings pile up. With the
@@ -74,7 +69,12 @@ pub(crate) fn whole_fill(
                 .map(|&(p, _)| p),
         );
         for split in [Split::AtCrossing, Split::Halving] {
-            match cdt_fill::fill(&all, &faces, split, Some(&height)) {
+            // Halving follows a try at crossings, so that one may give up early.
+            let patience = match split {
+                Split::AtCrossing => Patience::GiveUpEarly,
+                Split::Halving => Patience::Exhaustive,
+            };
+            match cdt_fill::fill(&all, &faces, split, Some(&height), patience) {
                 Ok(f) => {
                     filled = Some(f);
                     break 'fills;
@@ -119,6 +119,42 @@ pub(crate) fn whole_fill(
             whole_fill: true,
             ..FrontStats::default()
         },
+    })
+}
+
+/// What the fill is given: the surface's corners and the interior candidates.
+struct FillInput {
+    /// The corner nodes' global ids, sorted: local vertex `i` is `corners[i]`.
+    corners: Vec<u32>,
+    /// The corners' points, in local numbering.
+    pts: Vec<P3>,
+    /// The interior candidates, each with whether the surface encloses it.
+    interior: Vec<(P3, bool)>,
+    /// The corner triangles in local numbering, reversed: the fill wants the region on
+    /// each face's positive side.
+    faces: Vec<[u32; 3]>,
+}
+
+fn fill_input(
+    surf_nodes: &[P3],
+    surf_tris: &[[u32; 6]],
+    size: &SizeField,
+) -> Result<FillInput, String> {
+    let mut corners: Vec<u32> = surf_tris.iter().flat_map(|t| [t[0], t[1], t[2]]).collect();
+    corners.sort_unstable();
+    corners.dedup();
+    let local = |v: u32| corners.binary_search(&v).map_or(u32::MAX, |i| i as u32);
+    let pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
+    let interior = interior_points(&pts, surf_tris, &local, size)?;
+    let faces: Vec<[u32; 3]> = surf_tris
+        .iter()
+        .map(|t| [local(t[0]), local(t[2]), local(t[1])])
+        .collect();
+    Ok(FillInput {
+        corners,
+        pts,
+        interior,
+        faces,
     })
 }
 
@@ -335,6 +371,30 @@ mod tests {
         check_whole_fill("tests/data/openscad/offset.stl");
         // Crossings next to nearly flat tets: recovered by halving the segments.
         check_whole_fill("tests/data/openscad/example007.stl");
+    }
+
+    /// OpenSCAD's example012 with its interior points: at crossings, 41 of its 1,303
+    /// Steiner points stay on the surface in the first round of moving them off, and no
+    /// later round moves them all. Giving up there ([`Patience::GiveUpEarly`], which the
+    /// whole fill uses before halving) loses nothing: the exhaustive search fails too,
+    /// after three times as long; halving fills the part.
+    #[test]
+    fn crossings_give_up_early_only_where_the_search_would_fail() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/openscad/example012.stl");
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let size = crate::generate::size_field(&s, &Options::default());
+        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
+        let mut all = inp.pts.clone();
+        all.extend(inp.interior.iter().filter(|p| p.1).map(|p| p.0));
+        let fill = |split, patience| cdt_fill::fill(&all, &inp.faces, split, None, patience);
+        assert_eq!(
+            fill(Split::AtCrossing, Patience::GiveUpEarly).err(),
+            Some("too many Steiner points stay on the surface")
+        );
+        assert!(fill(Split::AtCrossing, Patience::Exhaustive).is_err());
+        let halved = fill(Split::Halving, Patience::Exhaustive).unwrap();
+        assert!(halved.pts.len() > all.len(), "no Steiner point");
     }
 
     /// The torus (R = 1, r = 0.35, axis z): the candidates inside the tube are marked
