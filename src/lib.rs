@@ -66,7 +66,7 @@ pub mod surface;
 pub mod threads;
 
 pub use error::{Error, Result, SurfaceDefect};
-pub use front::FrontStats;
+pub use front::{FillTry, FrontStats};
 pub use generate::{
     estimated_peak_memory, generate, generate_with_progress, Generated, StageTimes,
 };

@@ -732,6 +732,8 @@ fn add_front(a: &mut FrontStats, b: &FrontStats) {
     a.cavities += b.cavities;
     a.constrained += b.constrained;
     a.whole_fill |= b.whole_fill;
+    a.whole_fill_tries
+        .extend(b.whole_fill_tries.iter().cloned());
     a.p2_invalid += b.p2_invalid;
     a.restarts += b.restarts;
     a.alpha = b.alpha;

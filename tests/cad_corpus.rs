@@ -63,6 +63,12 @@ fn cad_exports_that_mesh_keep_meshing_exactly() {
         let g = generate(&s, &Options::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(g.report.num_invalid, 0, "{name}");
         assert_eq!(g.front.whole_fill, HANDED_OVER.contains(&name), "{name}");
+        // The report names the fill's tries, the last the one that filled.
+        let tries = &g.front.whole_fill_tries;
+        assert_eq!(tries.is_empty(), !g.front.whole_fill, "{name}");
+        if let Some(last) = tries.last() {
+            assert_eq!(last.error, None, "{name}: {tries:?}");
+        }
         check_mesh(&s, &g.mesh);
         eprintln!(
             "{name}: {} tets, min dihedral {:.2} deg, slivers {:?}",
@@ -102,6 +108,19 @@ fn a_cad_part_whose_crossings_stay_on_the_surface_meshes_by_halving() {
     assert_eq!(s.triangles().len(), 3_004);
     let g = generate(&s, &Options::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
     assert!(g.front.whole_fill);
+    // The try at crossings gave up after its first round; halving filled.
+    let tries = &g.front.whole_fill_tries;
+    assert_eq!(tries.len(), 2, "{tries:?}");
+    assert_eq!(tries[0].steiner_at, "crossings");
+    assert_eq!(
+        tries[0].error.as_deref(),
+        Some("too many Steiner points stay on the surface")
+    );
+    assert!(tries[0].steiner_points > 0 && tries[0].steiner_removal_seconds > 0.0);
+    assert_eq!(
+        (tries[1].steiner_at, tries[1].error.as_deref()),
+        ("halves", None)
+    );
     assert_eq!(g.report.num_invalid, 0);
     check_mesh_with_chords(&s, &g.mesh, true);
 }

@@ -23,7 +23,9 @@ impl Mesher<'_> {
             .map(|&f| self.faces[f as usize].v.map(local))
             .collect();
         let split = cdt_fill::Split::AtCrossing;
-        let Ok(filled) = cdt_fill::fill(&pts, &faces, split, None, Patience::Exhaustive) else {
+        let mut stages = cdt_fill::Stages::default();
+        let patience = Patience::Exhaustive;
+        let Ok(filled) = cdt_fill::fill(&pts, &faces, split, None, patience, &mut stages) else {
             return false;
         };
         // Global ids: the cavity's vertices, then the new points (not yet added).

@@ -76,6 +76,34 @@ pub struct FrontStats {
     /// No front attempt closed: the whole region was filled at once (interior points
     /// from the size field, then the constrained fill; see `whole_fill`).
     pub whole_fill: bool,
+    /// The whole fill's tries, in order, the last the one that filled (empty without a
+    /// whole fill).
+    pub whole_fill_tries: Vec<FillTry>,
+}
+
+/// One try of the whole fill (`whole_fill`): how it placed Steiner points, with which
+/// interior points, where it stopped, and the time of each stage it reached (0 for a
+/// stage not reached).
+#[derive(Debug, Default, Clone, serde::Serialize)]
+pub struct FillTry {
+    /// Where edge recovery put its Steiner points: `"crossings"` (where a segment
+    /// leaves a tet) or `"halves"` (halving the segment).
+    pub steiner_at: &'static str,
+    /// Whether the interior points outside the surface were inserted too (they change
+    /// the Delaunay tetrahedralization recovery starts from; their tets are dropped).
+    pub points_outside: bool,
+    /// Why the try stopped; None for the try that filled.
+    pub error: Option<String>,
+    /// Delaunay tetrahedralization of the surface's corners and the interior points.
+    pub delaunay_seconds: f64,
+    /// Recovery of the surface's edges.
+    pub edges_seconds: f64,
+    /// Recovery of the surface's triangles.
+    pub faces_seconds: f64,
+    /// Moving the Steiner points off the surface.
+    pub steiner_removal_seconds: f64,
+    /// Steiner points edge and face recovery added (all on the surface until moved).
+    pub steiner_points: usize,
 }
 
 #[derive(Clone, Copy)]

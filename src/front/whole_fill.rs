@@ -19,7 +19,7 @@
 
 use super::grid::{Aabb, FaceGrid};
 use super::size::SizeField;
-use super::{FrontOutput, FrontStats};
+use super::{FillTry, FrontOutput, FrontStats};
 use crate::geom::cdt_fill::{self, Patience, Split};
 use crate::geom::distance::point_triangle_dist2;
 use crate::geom::vec3::{axpy, cross, dist2, dot, mid, scale, sub, P3};
@@ -60,6 +60,7 @@ pub(crate) fn whole_fill(
     // Steiner points fall; their tets are dropped).
     let mut why = Vec::new();
     let mut filled = None;
+    let mut tries = Vec::new();
     'fills: for with_outside in [false, true] {
         let mut all = pts.clone();
         all.extend(
@@ -74,7 +75,22 @@ pub(crate) fn whole_fill(
                 Split::AtCrossing => Patience::GiveUpEarly,
                 Split::Halving => Patience::Exhaustive,
             };
-            match cdt_fill::fill(&all, &faces, split, Some(&height), patience) {
+            let mut stages = cdt_fill::Stages::default();
+            let r = cdt_fill::fill(&all, &faces, split, Some(&height), patience, &mut stages);
+            tries.push(FillTry {
+                steiner_at: match split {
+                    Split::AtCrossing => "crossings",
+                    Split::Halving => "halves",
+                },
+                points_outside: with_outside,
+                error: r.as_ref().err().map(|e| e.to_string()),
+                delaunay_seconds: stages.delaunay,
+                edges_seconds: stages.edges,
+                faces_seconds: stages.faces,
+                steiner_removal_seconds: stages.steiner_removal,
+                steiner_points: stages.steiner_points,
+            });
+            match r {
                 Ok(f) => {
                     filled = Some(f);
                     break 'fills;
@@ -117,6 +133,7 @@ pub(crate) fn whole_fill(
         quality,
         stats: FrontStats {
             whole_fill: true,
+            whole_fill_tries: tries,
             ..FrontStats::default()
         },
     })
@@ -387,7 +404,10 @@ mod tests {
         let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
         let mut all = inp.pts.clone();
         all.extend(inp.interior.iter().filter(|p| p.1).map(|p| p.0));
-        let fill = |split, patience| cdt_fill::fill(&all, &inp.faces, split, None, patience);
+        let fill = |split, patience| {
+            let mut stages = cdt_fill::Stages::default();
+            cdt_fill::fill(&all, &inp.faces, split, None, patience, &mut stages)
+        };
         assert_eq!(
             fill(Split::AtCrossing, Patience::GiveUpEarly).err(),
             Some("too many Steiner points stay on the surface")

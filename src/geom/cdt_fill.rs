@@ -43,25 +43,50 @@ pub(crate) struct Filled {
     pub tiny: usize,
 }
 
+/// Where a fill's time went, stage by stage (seconds; 0 for a stage not reached), and
+/// the Steiner points edge and face recovery added.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Stages {
+    pub delaunay: f64,
+    pub edges: f64,
+    pub faces: f64,
+    pub steiner_removal: f64,
+    pub steiner_points: usize,
+}
+
 /// Tetrahedralize the region bounded by `faces` (indices into `pts`, each oriented with the
 /// region on its positive side: `orient3d(a, b, c, x) > 0` for `x` inside). The result's
 /// boundary faces are exactly `faces`; new points are strictly inside. Err names the
 /// stage that could not go on (a degenerate or self-intersecting surface, or a rounded
-/// Steiner point that would invert a tet).
+/// Steiner point that would invert a tet). `stages` gets the time of each stage reached.
 pub(crate) fn fill(
     pts: &[P3],
     faces: &[[u32; 3]],
     split: Split,
     height: Option<&dyn Fn(P3) -> f64>,
     patience: Patience,
+    stages: &mut Stages,
 ) -> Result<Filled, &'static str> {
+    let mut clock = std::time::Instant::now();
+    let mut lap = || {
+        let t = clock.elapsed().as_secs_f64();
+        clock = std::time::Instant::now();
+        t
+    };
     let mut c = Cdt::new(pts, faces, split, patience)?;
-    c.recover_edges()?;
-    for i in 0..faces.len() {
-        c.recover_face(i)?;
-    }
+    stages.delaunay = lap();
+    let r = c.recover_edges();
+    stages.edges = lap();
+    stages.steiner_points = c.dt.pts.len() - pts.len() - 4;
+    r?;
+    let r = (0..faces.len()).try_for_each(|i| c.recover_face(i));
+    stages.faces = lap();
+    stages.steiner_points = c.dt.pts.len() - pts.len() - 4;
+    r?;
     c.keep_enclosed()?;
-    c.remove_steiner_points()?;
+    let r = c.remove_steiner_points();
+    stages.steiner_removal = lap();
+    r?;
     if let Some(h) = height {
         c.lift_flat_tets(h);
     }
@@ -1357,8 +1382,16 @@ mod tests {
     /// boundary exactly the input, volume the enclosed one.
     fn fill_and_check(pts: &[P3], outward: &[[u32; 3]]) -> Result<Filled, String> {
         let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
-        let r = fill(pts, &faces, Split::AtCrossing, None, Patience::Exhaustive)
-            .map_err(|e| e.to_string())?;
+        let mut stages = Stages::default();
+        let r = fill(
+            pts,
+            &faces,
+            Split::AtCrossing,
+            None,
+            Patience::Exhaustive,
+            &mut stages,
+        )
+        .map_err(|e| e.to_string())?;
         assert_eq!(&r.pts[..pts.len()], pts);
         let mut vol = 0.0;
         let mut uses: HashMap<[u32; 3], i32> = HashMap::default();
