@@ -10,7 +10,7 @@
 mod meshcheck;
 
 use curvetet::surface::curve::CurveOptions;
-use curvetet::{generate, io, Options};
+use curvetet::{generate, io, Generated, Options, Surface};
 use meshcheck::{check_mesh, check_mesh_with_chords};
 use std::path::PathBuf;
 
@@ -40,13 +40,21 @@ fn path(name: &str) -> PathBuf {
         .join(format!("{name}.stl"))
 }
 
+/// OpenSCAD part `name`, curved (with `ntri` triangles: the right file was read), and
+/// its mesh with default options.
+fn read_and_mesh(name: &str, ntri: usize) -> (Surface, Generated) {
+    let s = io::read_any_surface(&path(name), &CurveOptions::default())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    assert_eq!(s.triangles().len(), ntri, "{name}");
+    let g = generate(&s, &Options::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    (s, g)
+}
+
 #[test]
 fn cad_exports_that_mesh_keep_meshing_exactly() {
     for (name, ntri) in MESHED {
         let raw = io::read(&path(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let s = io::read_any_surface(&path(name), &CurveOptions::default())
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert_eq!(s.triangles().len(), ntri, "{name}");
+        let (s, g) = read_and_mesh(name, ntri);
         // The STL's vertices are the curved surface's corners, bit for bit (the STL reader
         // welds exact duplicates, so each corner is one of the file's float32 vertices).
         for t in s.triangles() {
@@ -60,7 +68,6 @@ fn cad_exports_that_mesh_keep_meshing_exactly() {
                 );
             }
         }
-        let g = generate(&s, &Options::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(g.report.num_invalid, 0, "{name}");
         assert_eq!(g.front.whole_fill, HANDED_OVER.contains(&name), "{name}");
         // The report names the fill's tries, the last the one that filled.
@@ -85,11 +92,7 @@ fn cad_exports_that_mesh_keep_meshing_exactly() {
 /// other surface node is the curved surface's, bit for bit.
 #[test]
 fn a_cad_part_meshes_with_its_uncertifiable_edges_straightened() {
-    let name = "example004";
-    let s = io::read_any_surface(&path(name), &CurveOptions::default())
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    assert_eq!(s.triangles().len(), 880);
-    let g = generate(&s, &Options::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let (s, g) = read_and_mesh("example004", 880);
     assert_eq!(g.report.num_invalid, 0);
     assert!(g.optimize.chords > 0, "{:?}", g.optimize);
     check_mesh_with_chords(&s, &g.mesh, true);
@@ -102,11 +105,7 @@ fn a_cad_part_meshes_with_its_uncertifiable_edges_straightened() {
 /// their chords.
 #[test]
 fn a_cad_part_whose_crossings_stay_on_the_surface_meshes_by_halving() {
-    let name = "CSG";
-    let s = io::read_any_surface(&path(name), &CurveOptions::default())
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-    assert_eq!(s.triangles().len(), 3_004);
-    let g = generate(&s, &Options::default()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let (s, g) = read_and_mesh("CSG", 3_004);
     assert!(g.front.whole_fill);
     // The try at crossings gave up after its first round; halving filled.
     let tries = &g.front.whole_fill_tries;
