@@ -4,7 +4,7 @@
 
 use super::validity::{self, FaceRef, TET_OUT_FACES};
 use super::{key3, Mesher};
-use crate::geom::cdt_fill::{self, Patience};
+use crate::geom::cdt_fill::{self, Patience, Split};
 use crate::geom::vec3::{tet_det, P3};
 
 /// Largest cavity (front faces) handed to the fill.
@@ -22,10 +22,10 @@ impl Mesher<'_> {
             .iter()
             .map(|&f| self.faces[f as usize].v.map(local))
             .collect();
-        let split = cdt_fill::Split::AtCrossing;
-        let mut stages = cdt_fill::Stages::default();
-        let patience = Patience::Exhaustive;
-        let Ok(filled) = cdt_fill::fill(&pts, &faces, split, None, patience, &mut stages) else {
+        // No other try follows here: the search runs every round.
+        let (split, patience) = (Split::AtCrossing, Patience::Exhaustive);
+        let stages = &mut Default::default();
+        let Ok(filled) = cdt_fill::fill(&pts, &faces, split, None, patience, stages) else {
             return false;
         };
         // Global ids: the cavity's vertices, then the new points (not yet added).

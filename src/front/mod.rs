@@ -1219,13 +1219,11 @@ fn stall_limit(surf_tris: usize) -> u64 {
 /// The fraction of the region's volume by which a front attempt must beat the most it
 /// has ever filled for the step and work counts of [`stall_limit`] and
 /// [`stall_work_limit`] to start again. Deleting and refilling the same pockets makes
-/// new maxima by a few tets' volume: logo_and_text crept from 95.7% to 96.4% filled in
-/// its last 16 s and 170,000 steps, each tiny maximum restarting the counts. Measured on
-/// the OpenSCAD corpus (the fill's volume at every 0.01% of progress, replayed with
-/// this rule): every attempt that closed still closes; the attempts that stall stall
-/// earlier, CSG at 2.9 s instead of 17 s and logo_and_text at 18 s instead of 32 s;
-/// 0.5% would also have cut example006, example012 and linear_extrude by 3-6 s each,
-/// but is further from what was checked on surfaces that close slowly.
+/// new maxima by a few tets' volume, and each such maximum would restart the counts of an
+/// attempt that is only going round. Chosen by replaying the OpenSCAD corpus's filled
+/// volume with this rule: every attempt that closed still closes, those that stall stall
+/// earlier (CHANGELOG has the figures); a larger margin is further from what was checked
+/// on surfaces that close slowly.
 const PROGRESS_FRACTION: f64 = 0.002;
 
 /// Validity-test work per surface triangle, and in all, that a front attempt may spend

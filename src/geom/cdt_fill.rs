@@ -122,10 +122,10 @@ pub(crate) enum Patience {
     Exhaustive,
     /// Give up once more than [`GIVE_UP_STUCK`] plus [`GIVE_UP_PER_MILLE`] per mille of the
     /// points have stayed on the surface in the first round: the caller has another way
-    /// ([`Split::Halving`]) that is cheaper than the search. On the OpenSCAD parts the
-    /// fill closed with [`Split::AtCrossing`], the first round left at most 3 of 1,168
-    /// points; where it left more (41 of 1,303 to 1,155 of 5,496) the later rounds did not
-    /// close it either, after up to a minute.
+    /// ([`Split::Halving`]) that is cheaper than the search. Fills that close leave almost
+    /// none after the first round; where many stay, the later rounds (grown cavities
+    /// included) did not close the fill either, after far longer (CHANGELOG has the
+    /// corpus figures).
     GiveUpEarly,
 }
 
