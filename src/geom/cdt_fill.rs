@@ -17,6 +17,10 @@
 //!    at the point: every inward step inverts it), the star grows through the faces a
 //!    point just inside does not see, until it sees them all ([`Cdt::grown_star`]). The
 //!    surface triangles come back exactly.
+//! 6. Points off the surface that numerically flat tets use are contracted into a
+//!    neighbour where that leaves fewer of them ([`Cdt::contract_flat`]): Steiner points
+//!    moved off a long segment one at a time stay almost on its line, and the tets
+//!    between them are flatter than the later stages can certify or repair.
 //!
 //! Every topological decision is an exact orient3d/orient2d; the Steiner coordinates are
 //! rounded, which the final checks cover: the boundary faces must be the input triangles
@@ -24,7 +28,7 @@
 
 use super::delaunay::{closes_up, sorted2, sorted3, Delaunay, FACES, NONE};
 use super::predicates::{orient3d, projection_of};
-use super::tet_quality::dihedral_extremes;
+use super::tet_quality::{dihedral_extremes, numerically_flat};
 use super::vec3::{axpy, dist, dot, norm, sub, tet_det, tri_normal, P3};
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 use std::collections::BTreeMap;
@@ -87,6 +91,7 @@ pub(crate) fn fill(
     let r = c.remove_steiner_points();
     stages.steiner_removal = lap();
     r?;
+    c.contract_flat();
     if let Some(h) = height {
         c.lift_flat_tets(h);
     }
@@ -99,6 +104,9 @@ pub(crate) fn fill(
 /// lifting where the apex is within a quarter edge of the face's plane, 8; below 10°,
 /// 10; below 20°, none.
 const LIFT_BELOW_DEG: f64 = 20.0;
+
+/// Rounds of [`Cdt::contract_flat`].
+const CONTRACT_ROUNDS: usize = 8;
 
 /// Rounds of [`Cdt::lift_flat_tets`].
 const LIFT_ROUNDS: usize = 2;
@@ -1049,6 +1057,129 @@ impl<'a> Cdt<'a> {
         closed.then_some((cavity, new))
     }
 
+    /// Remove the points off the surface that numerically flat tets use, where joining one
+    /// to a neighbour leaves fewer such tets (an edge contraction; every new tet positive
+    /// and the star tiled exactly), a few rounds while some point goes.
+    fn contract_flat(&mut self) {
+        let surface: HashSet<u32> = self.faces.iter().flatten().copied().collect();
+        let mut gone: HashSet<u32> = HashSet::default();
+        for _ in 0..CONTRACT_ROUNDS {
+            let flat: Vec<u32> = (0..self.dt.tets.len() as u32)
+                .filter(|&t| {
+                    self.dt.alive[t as usize]
+                        && numerically_flat(&self.dt.tets[t as usize].map(|v| self.dt.p(v)))
+                })
+                .collect();
+            let mut changed = 0;
+            for t in flat {
+                if !self.dt.alive[t as usize] {
+                    continue;
+                }
+                let tv = self.dt.tets[t as usize];
+                for q in tv {
+                    if surface.contains(&q) || gone.contains(&q) {
+                        continue;
+                    }
+                    if self.contract_point(q) {
+                        gone.insert(q);
+                        changed += 1;
+                        break;
+                    }
+                }
+            }
+            if changed == 0 {
+                break;
+            }
+        }
+    }
+
+    /// Contract point `q` (off the surface) into the star neighbour that leaves the fewest
+    /// numerically flat tets, fewer than its star has, then the largest smallest dihedral
+    /// angle; false (nothing changed) when none does.
+    fn contract_point(&mut self, q: u32) -> bool {
+        let star = self.dt.star(q);
+        let old: Vec<[u32; 4]> = star.iter().map(|&t| self.dt.tets[t as usize]).collect();
+        let shape = |dt: &Delaunay, tets: &[[u32; 4]]| {
+            let mut flat = 0usize;
+            let mut lo = f64::INFINITY;
+            for t in tets {
+                let c = t.map(|v| dt.p(v));
+                if numerically_flat(&c) {
+                    flat += 1;
+                } else {
+                    lo = lo.min(dihedral_extremes(&c).0);
+                }
+            }
+            (flat, lo)
+        };
+        let (flat0, _) = shape(&self.dt, &old);
+        // The star's outer faces.
+        let outer: HashSet<[u32; 3]> = old.iter().map(|t| sorted3(opposite(t, q))).collect();
+        let mut nbrs: Vec<u32> = old.iter().flatten().copied().filter(|&v| v != q).collect();
+        nbrs.sort_unstable();
+        nbrs.dedup();
+        let mut best: Option<(usize, f64, Vec<[u32; 4]>)> = None;
+        for w in nbrs {
+            let new: Vec<[u32; 4]> = old
+                .iter()
+                .filter(|t| !t.contains(&w))
+                .map(|t| t.map(|v| if v == q { w } else { v }))
+                .collect();
+            if new.is_empty() || !new.iter().all(|&t| self.dt.positive(t)) {
+                continue;
+            }
+            let (flat, lo) = shape(&self.dt, &new);
+            if flat >= flat0 || best.as_ref().is_some_and(|b| (flat, -lo) >= (b.0, -b.1)) {
+                continue;
+            }
+            if self.tiles(&outer, q, &new) {
+                best = Some((flat, lo, new));
+            }
+        }
+        let Some((_, _, new)) = best else {
+            return false;
+        };
+        self.dt.replace(&star, &new);
+        true
+    }
+
+    /// Whether the positive tets `new` tile the star of `q` whose outer faces are
+    /// `outer`: each face on two new tets, on opposite sides of it, or on one and an
+    /// outer face, on the side `q` is (then the tets' boundary is the star's, and
+    /// positive tets with that boundary cover it once).
+    fn tiles(&self, outer: &HashSet<[u32; 3]>, q: u32, new: &[[u32; 4]]) -> bool {
+        let mut apex: HashMap<[u32; 3], Vec<u32>> = HashMap::default();
+        for t in new {
+            for (k, fk) in FACES.iter().enumerate() {
+                apex.entry(sorted3(fk.map(|j| t[j])))
+                    .or_default()
+                    .push(t[k]);
+            }
+        }
+        let side = |f: &[u32; 3], x: u32| {
+            let p = f.map(|v| self.dt.p(v));
+            orient3d(p[0], p[1], p[2], self.dt.p(x))
+        };
+        let mut on_outer = 0;
+        for (f, xs) in &apex {
+            match (xs.as_slice(), outer.contains(f)) {
+                ([x], true) => {
+                    if side(f, *x) != side(f, q) {
+                        return false;
+                    }
+                    on_outer += 1;
+                }
+                ([x, y], false) => {
+                    if side(f, *x) * side(f, *y) >= 0 {
+                        return false;
+                    }
+                }
+                _ => return false,
+            }
+        }
+        on_outer == outer.len()
+    }
+
     /// Where a tet on a surface face is thin (a dihedral angle below [`LIFT_BELOW_DEG`]:
     /// two surface triangles at a shallow fold, or an apex on the surface elsewhere),
     /// insert a point above the face, at the height an equilateral
@@ -1528,6 +1659,40 @@ mod tests {
             let r = fill_and_check(&pts, &faces).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(r.tets.len() >= faces.len() / 4, "{name}");
         }
+    }
+
+    /// OpenSCAD's example018, filled from its boundary points: moving the Steiner points
+    /// off the surface leaves a numerically flat tet whose vertices are not all on the
+    /// surface; contracting one of them into a neighbour removes it, and the fill keeps
+    /// its boundary and volume.
+    #[test]
+    fn contraction_removes_the_flat_tets_moving_off_leaves() {
+        let (pts, outward) = openscad_corners("example018");
+        let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        let mut c = Cdt::new(&pts, &faces, Split::AtCrossing, Patience::Exhaustive).unwrap();
+        c.recover_edges().unwrap();
+        (0..faces.len())
+            .try_for_each(|i| c.recover_face(i))
+            .unwrap();
+        c.keep_enclosed().unwrap();
+        c.remove_steiner_points().unwrap();
+        let flat = |c: &Cdt| {
+            (0..c.dt.tets.len())
+                .filter(|&t| c.dt.alive[t] && numerically_flat(&c.dt.tets[t].map(|v| c.dt.p(v))))
+                .count()
+        };
+        assert!(
+            flat(&c) > 0,
+            "example018 no longer leaves a flat tet to contract"
+        );
+        c.contract_flat();
+        assert_eq!(flat(&c), 0);
+        let r = fill_and_check(&pts, &outward).unwrap();
+        let flat_left = r
+            .tets
+            .iter()
+            .filter(|t| numerically_flat(&t.map(|v| r.pts[v as usize])));
+        assert_eq!(flat_left.count(), 0);
     }
 
     /// OpenSCAD's example005 (a CAD part of needle triangles), filled from its boundary
