@@ -45,6 +45,11 @@ fn c3(p: P3) -> robust::Coord3D<f64> {
 
 /// A Delaunay tetrahedralization of `pts` (the first `n` points, the input) plus four
 /// enclosing points (ids `n..n + 4`).
+/// Relative 6 x volume (over the input's magnitude times the longest edge squared) above
+/// which a tet is clearly not flat by construction ([`Delaunay::clearly_solid`]): about
+/// a million units of roundoff.
+const SOLID_MARGIN: f64 = 1e-10;
+
 pub(crate) struct Delaunay {
     pub pts: Vec<P3>,
     /// Number of input points (the enclosing ones follow).
@@ -67,6 +72,9 @@ pub(crate) struct Delaunay {
     /// Faces (sorted ids) that no flip may remove: recovered constraint faces.
     pub fixed_faces: HashSet<[u32; 3]>,
     last: u32,
+    /// The largest absolute coordinate of the input points: the scale of the rounding
+    /// of every point added on an input edge or face ([`Delaunay::clearly_solid`]).
+    magnitude: f64,
 }
 
 impl Delaunay {
@@ -126,6 +134,7 @@ impl Delaunay {
             fixed_edges: HashSet::default(),
             fixed_faces: HashSet::default(),
             last: 0,
+            magnitude: pts.iter().flatten().fold(0.0, |m, x| m.max(x.abs())),
         };
         for i in 0..n as u32 {
             dt.insert(i);
@@ -315,10 +324,31 @@ impl Delaunay {
     /// plane of input points, exactly, so that only rounding makes it positive.
     pub(crate) fn valid_new(&self, t: [u32; 4]) -> bool {
         self.positive(t)
-            && !self.flat_by_construction(t)
-            && !FACES
-                .iter()
-                .any(|f| self.collinear_by_construction(f.map(|j| t[j])))
+            && (self.clearly_solid(t) || !self.flat_by_construction(t))
+            && (self.clearly_solid(t)
+                || !FACES
+                    .iter()
+                    .any(|f| self.collinear_by_construction(f.map(|j| t[j]))))
+    }
+
+    /// Whether tet `t` is far too thick for rounding to make it look so: then neither it
+    /// nor a face of it is flat by construction, and the exact tests (most of an
+    /// insertion's time where many added points crowd a segment) are skipped. An added
+    /// point is computed from input points (a point on a segment, interpolated; a
+    /// segment's crossing with a plane), within a small multiple of the unit roundoff of
+    /// [`Delaunay::magnitude`] of where it stands for; a tet whose points all stand on one
+    /// plane of input points, or a face on one line, so has 6 x volume at most a few
+    /// units of roundoff times the magnitude times its longest edge squared.
+    /// [`SOLID_MARGIN`] is a million times that.
+    fn clearly_solid(&self, t: [u32; 4]) -> bool {
+        let p = t.map(|v| self.p(v));
+        let l2 = (0..4)
+            .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
+            .map(|(i, j)| super::vec3::dist2(p[i], p[j]))
+            .fold(0.0, f64::max);
+        // A face's area is at least 6V / (2 x its opposite height) >= 6V / (2 sqrt(l2)).
+        let det = super::vec3::tet_det(p[0], p[1], p[2], p[3]);
+        det > 2.0 * SOLID_MARGIN * self.magnitude.max(l2.sqrt()) * l2
     }
 
     /// The input points an added point stands for (itself for an input point), for
