@@ -94,7 +94,8 @@ pub struct FillTry {
     pub points_outside: bool,
     /// Why the try stopped; None for the try that filled.
     pub error: Option<String>,
-    /// Delaunay tetrahedralization of the surface's corners and the interior points.
+    /// Delaunay tetrahedralization of the surface's corners and the interior points (0
+    /// for the second try on the same points: it starts from the first one's).
     pub delaunay_seconds: f64,
     /// Recovery of the surface's edges.
     pub edges_seconds: f64,

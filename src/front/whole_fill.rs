@@ -69,14 +69,29 @@ pub(crate) fn whole_fill(
                 .filter(|&&(_, inside)| inside || with_outside)
                 .map(|&(p, _)| p),
         );
+        // Both tries start from the same Delaunay tetrahedralization, built once (the
+        // first try's time has it).
+        let clock = std::time::Instant::now();
+        let dt = cdt_fill::delaunay(&all);
+        let mut built = clock.elapsed().as_secs_f64();
         for split in [Split::AtCrossing, Split::Halving] {
             // Halving follows a try at crossings, so that one may give up early.
             let patience = match split {
                 Split::AtCrossing => Patience::GiveUpEarly,
                 Split::Halving => Patience::Exhaustive,
             };
-            let mut stages = cdt_fill::Stages::default();
-            let r = cdt_fill::fill(&all, &faces, split, Some(&height), patience, &mut stages);
+            let mut stages = cdt_fill::Stages {
+                delaunay: std::mem::take(&mut built),
+                ..cdt_fill::Stages::default()
+            };
+            let r = cdt_fill::fill_from(
+                dt.clone(),
+                &faces,
+                split,
+                Some(&height),
+                patience,
+                &mut stages,
+            );
             tries.push(FillTry {
                 steiner_at: match split {
                     Split::AtCrossing => "crossings",

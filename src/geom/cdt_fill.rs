@@ -71,21 +71,43 @@ pub(crate) fn fill(
     patience: Patience,
     stages: &mut Stages,
 ) -> Result<Filled, &'static str> {
+    let clock = std::time::Instant::now();
+    let dt = Delaunay::new(pts);
+    stages.delaunay = clock.elapsed().as_secs_f64();
+    fill_from(dt, faces, split, height, patience, stages)
+}
+
+/// The Delaunay tetrahedralization [`fill`] starts from, for [`fill_from`]: tries with
+/// other ways on the same points build it once.
+pub(crate) fn delaunay(pts: &[P3]) -> Delaunay {
+    Delaunay::new(pts)
+}
+
+/// [`fill`] from the Delaunay tetrahedralization of its points ([`delaunay`]);
+/// `stages.delaunay` is left as it is.
+pub(crate) fn fill_from(
+    dt: Delaunay,
+    faces: &[[u32; 3]],
+    split: Split,
+    height: Option<&dyn Fn(P3) -> f64>,
+    patience: Patience,
+    stages: &mut Stages,
+) -> Result<Filled, &'static str> {
     let mut clock = std::time::Instant::now();
     let mut lap = || {
         let t = clock.elapsed().as_secs_f64();
         clock = std::time::Instant::now();
         t
     };
-    let mut c = Cdt::new(pts, faces, split, patience)?;
-    stages.delaunay = lap();
+    let n = dt.n;
+    let mut c = Cdt::new(dt, faces, split, patience)?;
     let r = c.recover_edges();
     stages.edges = lap();
-    stages.steiner_points = c.dt.pts.len() - pts.len() - 4;
+    stages.steiner_points = c.dt.pts.len() - n - 4;
     r?;
     let r = (0..faces.len()).try_for_each(|i| c.recover_face(i));
     stages.faces = lap();
-    stages.steiner_points = c.dt.pts.len() - pts.len() - 4;
+    stages.steiner_points = c.dt.pts.len() - n - 4;
     r?;
     c.keep_enclosed()?;
     let r = c.remove_steiner_points();
@@ -186,13 +208,12 @@ struct Cdt<'a> {
 
 impl<'a> Cdt<'a> {
     fn new(
-        pts: &[P3],
+        dt: Delaunay,
         faces: &'a [[u32; 3]],
         split: Split,
         patience: Patience,
     ) -> Result<Cdt<'a>, &'static str> {
-        let dt = Delaunay::new(pts);
-        let n = pts.len();
+        let n = dt.n;
         if faces.iter().flatten().any(|&v| v as usize >= n) {
             return Err("a face refers to a missing point");
         }
@@ -1669,7 +1690,13 @@ mod tests {
     fn contraction_removes_the_flat_tets_moving_off_leaves() {
         let (pts, outward) = openscad_corners("example018");
         let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
-        let mut c = Cdt::new(&pts, &faces, Split::AtCrossing, Patience::Exhaustive).unwrap();
+        let mut c = Cdt::new(
+            Delaunay::new(&pts),
+            &faces,
+            Split::AtCrossing,
+            Patience::Exhaustive,
+        )
+        .unwrap();
         c.recover_edges().unwrap();
         (0..faces.len())
             .try_for_each(|i| c.recover_face(i))

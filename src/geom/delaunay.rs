@@ -43,13 +43,14 @@ fn c3(p: P3) -> robust::Coord3D<f64> {
     }
 }
 
-/// A Delaunay tetrahedralization of `pts` (the first `n` points, the input) plus four
-/// enclosing points (ids `n..n + 4`).
 /// Relative 6 x volume (over the input's magnitude times the longest edge squared) above
 /// which a tet is clearly not flat by construction ([`Delaunay::clearly_solid`]): about
 /// a million units of roundoff.
 const SOLID_MARGIN: f64 = 1e-10;
 
+/// A Delaunay tetrahedralization of `pts` (the first `n` points, the input) plus four
+/// enclosing points (ids `n..n + 4`).
+#[derive(Clone)]
 pub(crate) struct Delaunay {
     pub pts: Vec<P3>,
     /// Number of input points (the enclosing ones follow).
