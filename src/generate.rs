@@ -230,8 +230,8 @@ fn generate_inner(
         if conf.is_ok() && !bad.is_empty() {
             let t = Instant::now();
             let (n_surf, chords) = (surface.nodes().len(), surface.chords_allowed());
-            let redo = |m: &mut TetMesh| {
-                if opts.optimize {
+            let redo = |m: &mut TetMesh, optimize: bool| {
+                if optimize && opts.optimize {
                     pool.install(|| optimize_high_order(m, &bnd, &high_order_params(opts)));
                 }
                 pool.install(|| uncertified(m))
@@ -300,14 +300,23 @@ fn generate_inner(
     })
 }
 
-/// Rounds of [`straighten_uncertified`].
+/// Rounds of [`straighten_uncertified`] that optimize again.
 const CHORD_ROUNDS: usize = 4;
+
+/// Rounds of [`straighten_uncertified`] after those, that only certify again.
+const STRAIGHT_ROUNDS: usize = 12;
 
 /// Where elements are left uncertified, put the mid nodes of their edges back on the
 /// chords and optimize and certify again (`redo`, which returns the elements still
-/// uncertified into `bad`); a few rounds, while some are left with curved edges. An
-/// interior edge always may; a boundary edge only on a surface curved from a linear one
-/// (`chords`: [`Surface::chords_allowed`]), whose own edges are the straight ones.
+/// uncertified into `bad`; its flag says whether to optimize); a few rounds, while some
+/// are left with curved edges. An interior edge always may; a boundary edge only on a
+/// surface curved from a linear one (`chords`: [`Surface::chords_allowed`]), whose own
+/// edges are the straight ones.
+///
+/// The first [`CHORD_ROUNDS`] optimize again, which can bend the straightened interior
+/// edges once more, so that each round leaves some elements uncertified again; the next
+/// [`STRAIGHT_ROUNDS`] only certify, so every round straightens for good, and an element
+/// whose edges all end up straight is valid where its corner tet is positive.
 ///
 /// A thin pocket of the surface can leave an interior vertex closer to a curved boundary
 /// edge than the edge bulges (the whole fill's tets on OpenSCAD's example004 and
@@ -320,10 +329,10 @@ fn straighten_uncertified(
     n_surf: usize,
     chords: bool,
     bad: &mut Vec<usize>,
-    mut redo: impl FnMut(&mut TetMesh) -> Vec<usize>,
+    mut redo: impl FnMut(&mut TetMesh, bool) -> Vec<usize>,
 ) -> [usize; 2] {
     let mut straightened = [0, 0];
-    for _ in 0..CHORD_ROUNDS {
+    for round in 0..CHORD_ROUNDS + STRAIGHT_ROUNDS {
         // (mid node, its chord midpoint, boundary?)
         let mut moves = Vec::new();
         for &e in bad.iter() {
@@ -347,7 +356,7 @@ fn straighten_uncertified(
                 straightened[usize::from(!boundary)] += 1;
             }
         }
-        *bad = redo(mesh);
+        *bad = redo(mesh, round < CHORD_ROUNDS);
         if bad.is_empty() {
             break;
         }
@@ -543,7 +552,7 @@ mod tests {
         let mut mesh = thin_tet([0.5, 0.0, 0.05], mid(D, A));
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0], "the bulging element must start uncertified");
-        let n = straighten_uncertified(&mut mesh, 6, true, &mut bad, |m| uncertified(m));
+        let n = straighten_uncertified(&mut mesh, 6, true, &mut bad, |m, _| uncertified(m));
         assert_eq!(n, [1, 0], "only the curved boundary edge is straightened");
         assert!(bad.is_empty(), "{bad:?}");
         assert_eq!(mesh.nodes[3], mid(A, B));
@@ -559,7 +568,7 @@ mod tests {
         let mut mesh = thin_tet(mid(A, B), bent);
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0], "the bent element must start uncertified");
-        let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m| uncertified(m));
+        let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m, _| uncertified(m));
         assert_eq!(n, [0, 1]);
         assert!(bad.is_empty(), "{bad:?}");
         assert_eq!(mesh.nodes[7], mid(D, A));
@@ -568,10 +577,36 @@ mod tests {
         let mut mesh = thin_tet(bulge, mid(D, A));
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0]);
-        let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m| uncertified(m));
+        let n = straighten_uncertified(&mut mesh, 6, false, &mut bad, |m, _| uncertified(m));
         assert_eq!(n, [0, 0]);
         assert_eq!(bad, vec![0]);
         assert_eq!(mesh.nodes[3], bulge);
+    }
+
+    /// An optimizer that bends a straightened interior edge back every time it runs (as
+    /// the high-order stage can, for a nearly flat tet among poor neighbours): the rounds
+    /// that only certify straighten it for good.
+    #[test]
+    fn rounds_that_only_certify_keep_a_straightened_edge_straight() {
+        let bent = [0.15, 0.15, -0.02];
+        let mut mesh = thin_tet(mid(A, B), bent);
+        let mut bad = uncertified(&mesh);
+        assert_eq!(bad, vec![0]);
+        let mut optimized = 0;
+        let redo = |m: &mut TetMesh, optimize: bool| {
+            if optimize {
+                optimized += 1;
+                m.nodes[7] = bent;
+            }
+            uncertified(m)
+        };
+        straighten_uncertified(&mut mesh, 6, false, &mut bad, redo);
+        assert_eq!(
+            optimized, CHORD_ROUNDS,
+            "every optimizing round ran and bent it back"
+        );
+        assert!(bad.is_empty(), "{bad:?}");
+        assert_eq!(mesh.nodes[7], mid(D, A));
     }
 
     fn mc_blob(smooth_iterations: u32) -> Surface {
