@@ -123,3 +123,22 @@ fn a_cad_part_whose_crossings_stay_on_the_surface_meshes_by_halving() {
     assert_eq!(g.report.num_invalid, 0);
     check_mesh_with_chords(&s, &g.mesh, true);
 }
+
+/// OpenSCAD's animation (needle triangles down to aspect ratio 57,246): the whole fill
+/// halves its long edges, and the Steiner points moved off them stay almost on their
+/// lines, between nearly coplanar needle triangles; the tets between such points were
+/// flatter than the later stages could repair or certify (3 uncertified). The fill
+/// contracts those points away, and the part meshes, certified.
+#[test]
+fn a_cad_part_of_needles_meshes_through_the_whole_fill() {
+    let (s, g) = read_and_mesh("animation", 2_702);
+    assert!(g.front.whole_fill);
+    let tries = &g.front.whole_fill_tries;
+    assert_eq!(
+        tries.last().map(|t| t.error.clone()),
+        Some(None),
+        "{tries:?}"
+    );
+    assert_eq!(g.report.num_invalid, 0);
+    check_mesh_with_chords(&s, &g.mesh, true);
+}
