@@ -1265,7 +1265,7 @@ impl<'a> Cdt<'a> {
                         o < 0 || (o == 0 && self.dt.adj[s as usize][k] != NONE)
                     });
                 let crowded = sv.iter().any(|&v| dist(self.dt.p(v), p) < 0.3 * h);
-                if inside && !crowded && self.dt.insert_point_in(s, p).is_some() {
+                if inside && !crowded && self.dt.insert_point_taking(s, p, Some(t)).is_some() {
                     added += 1;
                 }
             }

@@ -685,7 +685,23 @@ impl Delaunay {
 
     /// [`Delaunay::insert_point`] where tet `start` holds `p`.
     pub(crate) fn insert_point_in(&mut self, start: u32, p: P3) -> Option<u32> {
+        self.insert_point_taking(start, p, None)
+    }
+
+    /// [`Delaunay::insert_point_in`], with tet `take` in the cavity whatever the sphere
+    /// test says: it and the tets behind each cavity face of theirs that `p` does not see
+    /// join the cavity (a tet can go), or nothing changes. For a nearly flat tet whose
+    /// corners are nearly cocircular, a point above it can be outside its circumsphere.
+    pub(crate) fn insert_point_taking(
+        &mut self,
+        start: u32,
+        p: P3,
+        take: Option<u32>,
+    ) -> Option<u32> {
         let tv = self.tets[start as usize];
+        if take.is_some_and(|t| !self.alive[t as usize]) {
+            return None;
+        }
         if !self.alive[start as usize] || tv.iter().any(|&v| self.p(v) == p) {
             return None;
         }
@@ -711,6 +727,14 @@ impl Delaunay {
         };
         let mut cav = vec![start];
         let mut in_cav: HashSet<u32> = HashSet::from_iter([start]);
+        // `take` and the tets it brings in through faces p does not see.
+        let mut forced: HashSet<u32> = HashSet::default();
+        if let Some(t) = take {
+            forced.insert(t);
+            if in_cav.insert(t) {
+                cav.push(t);
+            }
+        }
         let mut k = 0;
         while k < cav.len() {
             let t = cav[k];
@@ -723,7 +747,11 @@ impl Delaunay {
                 }
                 // Every tet holding p, and those the sphere test takes.
                 let holds_p = *holds_p.get_or_insert_with(|| holds(self, t));
-                if (holds_p && on_face(self, t, j)) || self.in_sphere(nb, p) > 0 {
+                let unseen = forced.contains(&t) && !self.valid_new(new_tet(self, t, j));
+                if unseen {
+                    forced.insert(nb);
+                }
+                if unseen || (holds_p && on_face(self, t, j)) || self.in_sphere(nb, p) > 0 {
                     in_cav.insert(nb);
                     cav.push(nb);
                 }
@@ -775,8 +803,8 @@ impl Delaunay {
             }
             let mut removed = false;
             for t in out {
-                // A tet holding p cannot go.
-                if in_cav.contains(&t) && !holds(self, t) {
+                // A tet holding p cannot go, nor can `take`.
+                if in_cav.contains(&t) && !holds(self, t) && Some(t) != take {
                     in_cav.remove(&t);
                     removed = true;
                 }
