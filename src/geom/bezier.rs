@@ -27,7 +27,7 @@
 
 use super::predicates::orient3d;
 use super::shape::{tet10_det_jacobian, TET10_EDGES};
-use super::vec3::{cross, det3, dot, mid, sub, tet_det, P3};
+use super::vec3::{cross, det3, dot, mid, norm, sub, tet_det, P3};
 
 /// Multi-indices (a_0, a_1, a_2, a_3), |a| = 3, of the 20 cubic Bernstein coefficients in
 /// the order [`jacobian_bezier`] returns them: the 4 corners (0..4), then two per edge in
@@ -465,31 +465,62 @@ pub fn fixed_coefficients_positive(b: &[f64; 20], tau: f64, free_mid: [bool; 6])
     })
 }
 
+/// How far det J of a straight-sided 10-node tet ([`is_straight`]) can be from its corner
+/// determinant, computed in f64: each mid node is its edge's midpoint rounded to f64
+/// (at most u·M off per coordinate, M the largest corner coordinate, u = 2^-53), which
+/// moves the Jacobian's columns by at most 8u·M per component anywhere in the element,
+/// and the determinant's own rounding. With C_d = |x_d − x_0|: the same form as
+/// [`LinearJacobian::rounding_margin`], with M for the extent,
+/// 128u·M·(C_1C_2 + C_1C_3 + C_2C_3) + 32u·C_1C_2C_3, several times the bound.
+fn straight_margin(x: &[P3; 10]) -> f64 {
+    let u = f64::EPSILON * 0.5;
+    let m = x[..4]
+        .iter()
+        .flat_map(|p| p.iter())
+        .fold(0.0f64, |a, &v| a.max(v.abs()));
+    let c = [1, 2, 3].map(|d| norm(sub(x[d], x[0])));
+    32.0 * u * c[0] * c[1] * c[2] + 128.0 * u * m * (c[0] * c[1] + c[0] * c[2] + c[1] * c[2])
+}
+
+/// The corner determinant of a straight-sided tet and its [`straight_margin`], when the
+/// determinant is farther than that from 0 (or not finite): det J is then that constant
+/// to within the margin. None for a curved tet or a nearly flat straight one.
+fn straight_decided(x: &[P3; 10]) -> Option<(f64, f64)> {
+    if !is_straight(x) {
+        return None;
+    }
+    let d = tet_det(x[0], x[1], x[2], x[3]);
+    let margin = straight_margin(x);
+    (d.abs() > margin || !d.is_finite()).then_some((d, margin))
+}
+
 /// Proves or disproves det J > 0 on the whole element: one set of Bernstein coefficients
 /// decides almost every element; inconclusive ones (some coefficient <= 0 while the
 /// sampled values are positive) are resolved by adaptive red refinement, up to
 /// [`MAX_DEPTH`] levels and [`MAX_SUBDOMAINS`] sub-tets. Allocation-free.
 pub fn certify(x: &[P3; 10]) -> Certificate {
     if is_straight(x) {
-        // det J is the constant corner determinant: its sign comes from the exact
-        // predicate; `min_lower` is its floating-point value.
+        // det J is the corner determinant up to the rounding of the mid nodes to the
+        // nearest f64 of their edges' midpoints (`straight_margin`): above that it is
+        // certified here; a positive tet below it (nearly flat) goes through the
+        // Bernstein coefficients of its actual nodes, like a curved one.
         let d = tet_det(x[0], x[1], x[2], x[3]);
-        if orient3d(x[0], x[1], x[2], x[3]) > 0 {
-            return if d > 0.0 {
-                Certificate::Valid { min_lower: d }
-            } else {
-                // Positive, but below what f64 resolves: numerically degenerate.
-                Certificate::Undecided { min_lower: 0.0 }
+        if orient3d(x[0], x[1], x[2], x[3]) <= 0 {
+            let p = [0.25; 3];
+            let v = tet10_det_jacobian(x, p);
+            if v <= 0.0 {
+                return Certificate::Invalid { point: p, value: v };
+            }
+            return Certificate::Undecided {
+                min_lower: if d.is_nan() { d } else { d.min(0.0) },
             };
         }
-        let p = [0.25; 3];
-        let v = tet10_det_jacobian(x, p);
-        if v <= 0.0 {
-            return Certificate::Invalid { point: p, value: v };
+        let margin = straight_margin(x);
+        if d > margin {
+            return Certificate::Valid {
+                min_lower: d - margin,
+            };
         }
-        return Certificate::Undecided {
-            min_lower: if d.is_nan() { d } else { d.min(0.0) },
-        };
     }
     let lj = LinearJacobian::new(x);
     let tau = lj.rounding_margin();
@@ -532,14 +563,13 @@ pub fn certify(x: &[P3; 10]) -> Certificate {
 /// (1 - rel_tol), roughly), or the work limits are hit (bounds stay valid, just looser).
 /// For an element found invalid the refinement stops at once.
 pub fn jacobian_bounds(x: &[P3; 10], rel_tol: f64) -> JacobianBounds {
-    if is_straight(x) {
-        let d = tet_det(x[0], x[1], x[2], x[3]);
+    if let Some((d, margin)) = straight_decided(x) {
         return JacobianBounds {
-            min_lower: d,
+            min_lower: d - margin,
             min_upper: d,
             min_point: [0.0; 3],
             max_lower: d,
-            max_upper: d,
+            max_upper: d + margin,
             subdomains: 0,
             exhausted: false,
         };
@@ -574,10 +604,11 @@ pub fn jacobian_bounds(x: &[P3; 10], rel_tol: f64) -> JacobianBounds {
 /// A certified lower bound on the scaled Jacobian min det J / max det J of `x`, tightened
 /// by subdivision to relative tolerance `rel_tol` (1e-3 is a good default; smaller costs
 /// more). Always <= the true value; <= 0 when the element is (or may be) invalid; exactly
-/// 1.0 for a straight-sided tet (free fast path). See [`JacobianBounds::scaled_lower`] for
+/// 1.0 for a straight-sided tet that is not nearly flat (free fast path; see
+/// [`straight_margin`]). See [`JacobianBounds::scaled_lower`] for
 /// the conventions on inverted elements.
 pub fn scaled_jacobian_certified(x: &[P3; 10], rel_tol: f64) -> f64 {
-    if is_straight(x) {
+    if straight_decided(x).is_some() {
         return straight_scaled_jacobian(x);
     }
     jacobian_bounds(x, rel_tol).scaled_lower()
@@ -966,6 +997,40 @@ mod tests {
         }
     }
 
+    /// A straight-sided tet one ulp thick, far from the origin: its mid nodes are its
+    /// edges' midpoints rounded to f64, half its thickness off, so the P2 element those
+    /// ten nodes define is inverted in places although its corner determinant is
+    /// positive. Certification must not call it valid.
+    #[test]
+    fn a_straight_tet_thinner_than_its_mid_node_rounding_is_not_certified() {
+        let x0: f64 = 1.0e6;
+        let up = f64::from_bits(x0.to_bits() + 1);
+        let x = straight_tet10([
+            [x0, 0.0, 0.0],
+            [x0, 1.0, 0.0],
+            [x0, 0.0, 1.0],
+            [up, 0.3, 0.3],
+        ]);
+        assert!(is_straight(&x));
+        let corner = tet_det(x[0], x[1], x[2], x[3]);
+        let x = if corner > 0.0 {
+            x
+        } else {
+            straight_tet10([x[0], x[2], x[1], x[3]])
+        };
+        assert!(orient3d(x[0], x[1], x[2], x[3]) > 0);
+        let mut rng = StdRng::seed_from_u64(3);
+        let negative = (0..2000).any(|_| {
+            let mut l: [f64; 4] = std::array::from_fn(|_| rng.random::<f64>());
+            let s: f64 = l.iter().sum();
+            l.iter_mut().for_each(|v| *v /= s);
+            tet10_det_jacobian(&x, [l[1], l[2], l[3]]) < 0.0
+        });
+        assert!(negative, "the rounded mid nodes invert no sampled point");
+        assert!(!certify(&x).is_valid(), "{:?}", certify(&x));
+        assert!(scaled_jacobian_certified(&x, 1e-3) <= 0.0);
+    }
+
     #[test]
     fn expanded_coefficients_match_the_table() {
         let mut rng = StdRng::seed_from_u64(8);
@@ -992,7 +1057,12 @@ mod tests {
         assert!(is_straight(&x));
         assert_eq!(jacobian_bezier(&x), [d; 20]);
         assert_eq!(scaled_jacobian_certified(&x, 1e-3), 1.0);
-        assert_eq!(certify(&x), Certificate::Valid { min_lower: d });
+        assert_eq!(
+            certify(&x),
+            Certificate::Valid {
+                min_lower: d - straight_margin(&x)
+            }
+        );
         // The general path (no fast path) agrees to rounding.
         let b = LinearJacobian::new(&x).bezier();
         for v in b {
@@ -1225,8 +1295,10 @@ mod tests {
     #[test]
     fn straight_tets_use_the_exact_sign() {
         // Corners rounded onto a tilted plane: the float determinant's sign is noise,
-        // the exact predicate's is not. Validity and the straight scaled Jacobian follow
-        // the exact sign.
+        // the exact predicate's is not. Whatever either sign, det J is below the rounding
+        // of the mid nodes ([`straight_margin`]): never certified, and a certified scaled
+        // Jacobian of at most 0; an invalid one only where the exact sign is not
+        // positive.
         let mut rng = StdRng::seed_from_u64(12);
         let (a, u, v) = ([0.1, 0.2, 0.3], [0.7, 0.3, 0.11], [0.2, 0.9, 0.37]);
         let on_plane = |s: f64, t: f64| -> P3 {
@@ -1248,10 +1320,10 @@ mod tests {
             if (o > 0) != (d > 0.0) {
                 disagreements += 1;
             }
-            assert_eq!(scaled_jacobian_certified(&x, 1e-3), f64::from(o));
+            assert!(scaled_jacobian_certified(&x, 1e-3) <= 0.0);
             match certify(&x) {
-                Certificate::Valid { min_lower } => assert!(o > 0 && min_lower > 0.0),
-                Certificate::Invalid { value, .. } => assert!(o <= 0 && value <= 0.0),
+                Certificate::Valid { .. } => panic!("{c:?} certified"),
+                Certificate::Invalid { value, .. } => assert!(o <= 0 || value <= 0.0),
                 Certificate::Undecided { .. } => {}
             }
         }
