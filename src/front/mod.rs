@@ -349,8 +349,11 @@ pub(crate) struct Mesher<'a> {
     /// Validity-test work so far: front faces gathered for a candidate's test, plus one
     /// per gather (see [`stall_work_limit`]).
     work: u64,
-    /// Set when the attempt gave up by [`Mesher::stall_limit`] or
-    /// [`Mesher::stall_work_limit`].
+    /// Validity-test work this attempt may do in all ([`front_work_budget`], less what
+    /// earlier attempts spent); u64::MAX: no bound.
+    work_budget: u64,
+    /// Set when the attempt gave up by [`Mesher::stall_limit`],
+    /// [`Mesher::stall_work_limit`] or [`Mesher::work_budget`].
     stalled: bool,
     /// Close stuck cavities by the constrained fill (off only in tests of the repair path).
     use_fill: bool,
@@ -425,6 +428,7 @@ impl<'a> Mesher<'a> {
             stall_limit: stall_limit(surf_tris.len()),
             stall_work_limit: stall_work_limit(surf_tris.len()),
             work: 0,
+            work_budget: u64::MAX,
             stalled: false,
             use_fill: fill_enabled(),
             fill_p2_invalid: true,
@@ -663,6 +667,14 @@ impl<'a> Mesher<'a> {
                     "{} steps ({} face tests) without filling more of the volume",
                     self.stats.steps - best_step,
                     self.work - best_work
+                );
+                return Err(self.stuck_error(fid, &why));
+            }
+            if self.work > self.work_budget {
+                self.stalled = true;
+                let why = format!(
+                    "{} face tests, the front's budget on this surface",
+                    self.work
                 );
                 return Err(self.stuck_error(fid, &why));
             }
@@ -1245,6 +1257,24 @@ fn stall_work_limit(surf_tris: usize) -> u64 {
     STALL_WORK_PER_TRIANGLE * surf_tris as u64 + STALL_WORK_BASE
 }
 
+/// Validity-test work per surface triangle, and in all, that the front's attempts may
+/// spend together before the region goes to the whole fill ([`front_work_budget`]).
+const FRONT_WORK_PER_TRIANGLE: u64 = 30_000;
+const FRONT_WORK_BASE: u64 = 40_000_000;
+
+/// The validity-test work (as [`stall_work_limit`] counts it) that the front's attempts
+/// may spend in all before the region goes to the whole fill ([`run_front`]). The
+/// front's cost per filled tet grows as it nears a surface it cannot close: on the
+/// OpenSCAD corpus the attempts that closed spent at most 7.3e4 per surface triangle
+/// (example007; 5e4 or less on the others, 2.9e4 on example018's 4,960), and the ones
+/// that stalled 2e4-1.2e6 (example019: 4.5e9 on 3,912 triangles, 46 s) before the stall
+/// limits stopped them, a third of the corpus's time for meshes that were then thrown
+/// away. Deterministic: counted in work, not time. Once the whole fill has failed, the
+/// remaining attempts run without it.
+fn front_work_budget(surf_tris: usize) -> u64 {
+    FRONT_WORK_PER_TRIANGLE * surf_tris as u64 + FRONT_WORK_BASE
+}
+
 /// Restart schedule, as (alpha factor, size factor): when local remeshing cannot close the
 /// front, the whole front runs again with a narrower, then a wider candidate search, then a
 /// finer size. The front is greedy; another radius changes every choice it makes, so a
@@ -1292,6 +1322,8 @@ pub fn run_front(
     let mut last_partial = None;
     // The whole fill's error, once it has been tried.
     let mut fill_failed: Option<String> = None;
+    // Front work spent by the attempts so far (see `front_work_budget`).
+    let mut spent = 0u64;
     let attempts = if front_enabled() {
         RESTARTS.len()
     } else {
@@ -1307,6 +1339,9 @@ pub fn run_front(
         m.stage = attempt_stage(attempt);
         m.max_repairs_without_progress = repairs_without_progress_limit(attempt);
         m.fill_p2_invalid = attempt + 1 < RESTARTS.len();
+        if fill_failed.is_none() {
+            m.work_budget = front_work_budget(surf_tris.len()).saturating_sub(spent);
+        }
         match m.run(progress) {
             Ok(()) => {
                 // The live tets and their qualities.
@@ -1322,6 +1357,7 @@ pub fn run_front(
                 });
             }
             Err(Error::MeshingFailed { msg, partial }) => {
+                spent += m.work;
                 failures.push(format!("alpha {:.3}, size x{fs}: {msg}", m.alpha));
                 last_partial = partial;
                 // A stalled front hands the region to the whole fill at once (tried once;
@@ -1449,6 +1485,38 @@ mod tests {
             .and_then(|n| n.parse().ok())
             .unwrap_or_else(|| panic!("{msg}"));
         assert!(steps <= m.stall_limit, "{msg}");
+    }
+
+    /// OpenSCAD's example002: the first attempt fills most of the volume, then spends
+    /// over three times its budget in work before the stall limits stop it; the budget
+    /// ends it first. example018 closes slowly (the most work per triangle of the
+    /// attempts in `tests/data/openscad` that close) and still closes within it.
+    #[test]
+    fn the_front_stops_at_its_work_budget_and_closes_within_it_where_it_can() {
+        let opts = Options::default();
+        let attempt = |name: &str| {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join(format!("tests/data/openscad/{name}.stl"));
+            let s = crate::io::read_any_surface(&path, &Default::default()).expect(name);
+            let size = crate::generate::size_field(&s, &opts);
+            let mut m = Mesher::new(s.nodes(), s.triangles(), &opts, &size);
+            let budget = front_work_budget(s.triangles().len());
+            m.work_budget = budget;
+            let r = m.run(&mut |_, _| false);
+            (r, m.stalled, m.work, budget, m.open_faces)
+        };
+        let (r, stalled, work, budget, _) = attempt("example002");
+        let Err(Error::MeshingFailed { msg, .. }) = r else {
+            panic!("example002's first attempt was expected to fail");
+        };
+        assert!(stalled && msg.contains("budget"), "{msg}");
+        assert!(
+            work > budget && work < budget + budget / 10,
+            "{work} {budget}"
+        );
+        let (r, _, work, budget, open) = attempt("example018");
+        assert!(r.is_ok() && open == 0, "{:?}", r.err());
+        assert!(work <= budget, "{work} {budget}");
     }
 
     #[test]
