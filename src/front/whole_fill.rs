@@ -76,8 +76,10 @@ pub(crate) fn whole_fill(
         let mut built = clock.elapsed().as_secs_f64();
         for split in [Split::AtCrossing, Split::Halving] {
             // Halving follows a try at crossings, so that one may give up early.
+            // The last try has no other way after it.
             let patience = match split {
                 Split::AtCrossing => Patience::GiveUpEarly,
+                Split::Halving if with_outside => Patience::LastResort,
                 Split::Halving => Patience::Exhaustive,
             };
             let mut stages = cdt_fill::Stages {
@@ -430,6 +432,44 @@ mod tests {
         assert!(fill(Split::AtCrossing, Patience::Exhaustive).is_err());
         let halved = fill(Split::Halving, Patience::Exhaustive).unwrap();
         assert!(halved.pts.len() > all.len(), "no Steiner point");
+    }
+
+    /// OpenSCAD's GEB (four shells of needle facets), as the whole fill's last try fills
+    /// it (halving, with the points outside): one Steiner point, on an edge between two
+    /// coplanar facets and crowded by the points of nearby segments, stays on the surface
+    /// through every regular round (no cavity of up to 400 tets lets it off); the last
+    /// round's larger cavities move it, and the fill closes where it failed.
+    #[test]
+    fn the_last_steiner_point_of_a_crowded_edge_moves_off_with_a_larger_cavity() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad/GEB.stl");
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let size = crate::generate::size_field(&s, &Options::default());
+        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
+        let mut all = inp.pts.clone();
+        all.extend(inp.interior.iter().map(|p| p.0));
+        let fill = |patience| {
+            let mut stages = cdt_fill::Stages::default();
+            let r = cdt_fill::fill(
+                &all,
+                &inp.faces,
+                Split::Halving,
+                None,
+                patience,
+                &mut stages,
+            );
+            (r, stages)
+        };
+        let (r, stages) = fill(Patience::Exhaustive);
+        assert_eq!(
+            r.err(),
+            Some("no interior point sees a Steiner point's star")
+        );
+        assert!(stages.wide_cavity_points > 0);
+        let (r, stages) = fill(Patience::LastResort);
+        let filled = r.unwrap_or_else(|e| panic!("{e}"));
+        assert!(stages.wide_cavity_points > 0);
+        assert_eq!(&filled.pts[..all.len()], &all[..]);
     }
 
     /// The torus (R = 1, r = 0.35, axis z): the candidates inside the tube are marked

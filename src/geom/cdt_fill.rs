@@ -56,6 +56,9 @@ pub(crate) struct Stages {
     pub faces: f64,
     pub steiner_removal: f64,
     pub steiner_points: usize,
+    /// Steiner points that only the last round's larger cavities could move off the
+    /// surface ([`GROW_LIMIT_LAST`]), or that stayed on it.
+    pub wide_cavity_points: usize,
 }
 
 /// Tetrahedralize the region bounded by `faces` (indices into `pts`, each oriented with the
@@ -112,6 +115,7 @@ pub(crate) fn fill_from(
     c.keep_enclosed()?;
     let r = c.remove_steiner_points();
     stages.steiner_removal = lap();
+    stages.wide_cavity_points = c.wide_cavity_points;
     r?;
     c.contract_flat();
     if let Some(h) = height {
@@ -157,6 +161,12 @@ pub(crate) enum Patience {
     /// included) did not close the fill either, after far longer (CHANGELOG has the
     /// corpus figures).
     GiveUpEarly,
+    /// [`Patience::Exhaustive`], then one more round with far larger cavities
+    /// ([`GROW_LIMIT_LAST`]) for the points still on the surface: the last way there is.
+    /// Where another way follows, that way makes a better fill (on OpenSCAD's animation,
+    /// halving without the points outside closed this way left 32 elements that could
+    /// not be certified; with them it needs no such round).
+    LastResort,
 }
 
 /// Stuck points in the first round that [`Patience::GiveUpEarly`] accepts, plus ...
@@ -170,6 +180,13 @@ const MAX_UNBLOCK: usize = 64;
 
 /// Most tets a Steiner point's cavity grows to ([`Cdt::grown_star`]).
 const GROW_LIMIT: usize = 400;
+
+/// Most tets a cavity grows to in a last round for the Steiner points that no cavity
+/// within [`GROW_LIMIT`] moves off the surface. On OpenSCAD's GEB one point on an edge
+/// between two coplanar facets, crowded by the points of nearby recovered segments, stayed
+/// (its star 80 tets); the fill then failed. Only fills that would fail reach this round,
+/// and only with [`Patience::LastResort`].
+const GROW_LIMIT_LAST: usize = 4_000;
 
 /// Step lengths tried for a grown cavity's point: `reach / 2^k` for k in 2..this.
 const GROW_STEPS: i32 = 40;
@@ -204,6 +221,10 @@ struct Cdt<'a> {
     tiny: usize,
     /// Whether [`Cdt::move_off`] may grow a cavity (the last rounds only).
     grow: bool,
+    /// Most tets a grown cavity may have ([`GROW_LIMIT`], then [`GROW_LIMIT_LAST`]).
+    grow_limit: usize,
+    /// Points that reached the round with [`GROW_LIMIT_LAST`].
+    wide_cavity_points: usize,
 }
 
 impl<'a> Cdt<'a> {
@@ -241,6 +262,8 @@ impl<'a> Cdt<'a> {
             grown: 0,
             tiny: 0,
             grow: false,
+            grow_limit: GROW_LIMIT,
+            wide_cavity_points: 0,
         })
     }
 
@@ -641,7 +664,7 @@ impl<'a> Cdt<'a> {
         // with grown cavities ([`Cdt::grown_star`]): their search costs more, and a point
         // that would move in a later round does not pay it.
         let give_up = match self.patience {
-            Patience::Exhaustive => usize::MAX,
+            Patience::Exhaustive | Patience::LastResort => usize::MAX,
             Patience::GiveUpEarly => GIVE_UP_STUCK + left.len() * GIVE_UP_PER_MILLE / 1000,
         };
         let mut first_round = true;
@@ -668,6 +691,20 @@ impl<'a> Cdt<'a> {
                     break;
                 }
             }
+        }
+        // The points still left: one round with far larger cavities, where no other way
+        // follows.
+        self.wide_cavity_points = left.len();
+        if self.patience == Patience::LastResort {
+            self.grow_limit = GROW_LIMIT_LAST;
+            let mut stuck = Vec::new();
+            for &(s, n) in &left {
+                let n = self.remove_one(s, n)?;
+                if n > 0 {
+                    stuck.push((s, n));
+                }
+            }
+            left = stuck;
         }
         if left.is_empty() {
             Ok(())
@@ -1003,7 +1040,7 @@ impl<'a> Cdt<'a> {
     /// does not see strictly (positively) is crossed into the tet behind it, Bowyer-Watson
     /// fashion, until `q` sees them all: the cavity is then star-shaped from `q`, so the
     /// new tets fill it. None where the face to cross is a surface face, the tet behind it
-    /// has `s` (another pocket), the cavity passes [`GROW_LIMIT`] tets, or `q` is not
+    /// has `s` (another pocket), the cavity passes [`Cdt::grow_limit`] tets, or `q` is not
     /// strictly inside `faces`; interior points the cavity swallows are dropped.
     fn grown_star(
         &self,
@@ -1041,7 +1078,7 @@ impl<'a> Cdt<'a> {
             }
             inside.insert(nb);
             cavity.push(nb);
-            if cavity.len() > GROW_LIMIT {
+            if cavity.len() > self.grow_limit {
                 return None;
             }
             todo.extend((0..4).map(|k| (nb, k)));
