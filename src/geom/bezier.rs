@@ -604,9 +604,9 @@ pub fn jacobian_bounds(x: &[P3; 10], rel_tol: f64) -> JacobianBounds {
 /// A certified lower bound on the scaled Jacobian min det J / max det J of `x`, tightened
 /// by subdivision to relative tolerance `rel_tol` (1e-3 is a good default; smaller costs
 /// more). Always <= the true value; <= 0 when the element is (or may be) invalid; exactly
-/// 1.0 for a straight-sided tet that is not nearly flat (free fast path; see
-/// [`straight_margin`]). See [`JacobianBounds::scaled_lower`] for
-/// the conventions on inverted elements.
+/// 1.0 for a straight-sided tet that is not nearly flat (free fast path; a tet thinner
+/// than the rounding of its mid nodes to f64 takes the general path). See
+/// [`JacobianBounds::scaled_lower`] for the conventions on inverted elements.
 pub fn scaled_jacobian_certified(x: &[P3; 10], rel_tol: f64) -> f64 {
     if straight_decided(x).is_some() {
         return straight_scaled_jacobian(x);
