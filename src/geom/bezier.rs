@@ -1297,8 +1297,7 @@ mod tests {
         // Corners rounded onto a tilted plane: the float determinant's sign is noise,
         // the exact predicate's is not. Whatever either sign, det J is below the rounding
         // of the mid nodes ([`straight_margin`]): never certified, and a certified scaled
-        // Jacobian of at most 0; an invalid one only where the exact sign is not
-        // positive.
+        // Jacobian of at most 0; found invalid only with a witness point.
         let mut rng = StdRng::seed_from_u64(12);
         let (a, u, v) = ([0.1, 0.2, 0.3], [0.7, 0.3, 0.11], [0.2, 0.9, 0.37]);
         let on_plane = |s: f64, t: f64| -> P3 {
@@ -1323,7 +1322,10 @@ mod tests {
             assert!(scaled_jacobian_certified(&x, 1e-3) <= 0.0);
             match certify(&x) {
                 Certificate::Valid { .. } => panic!("{c:?} certified"),
-                Certificate::Invalid { value, .. } => assert!(o <= 0 || value <= 0.0),
+                // The witness is a point where the ten nodes' det J is not positive.
+                Certificate::Invalid { point, value } => {
+                    assert!(value <= 0.0 && tet10_det_jacobian(&x, point) <= 0.0)
+                }
                 Certificate::Undecided { .. } => {}
             }
         }
