@@ -175,6 +175,14 @@ const GIVE_UP_STUCK: usize = 16;
 /// ... this many per thousand Steiner points.
 const GIVE_UP_PER_MILLE: usize = 10;
 
+/// With [`Split::Halving`], a piece of a segment shorter than `2^-this` of the segment
+/// that crosses a mesh edge exactly is split at that crossing, not halved again. Where
+/// the segment is one diagonal of a planar quad of surface points and the mesh has the
+/// other, every midpoint (rounded off the segment's line) leaves a piece crossing that
+/// edge: on OpenSCAD's CSG-modules halving put 61 points within 1e-4 of the crossing on
+/// a 4.4 long segment, and two of them could then not be moved off the surface.
+const HALVING_DEPTH: i32 = 10;
+
 /// Flips tried per segment or face to clear nearly flat tets out of a split's way.
 const MAX_UNBLOCK: usize = 64;
 
@@ -184,8 +192,9 @@ const GROW_LIMIT: usize = 400;
 /// Most tets a cavity grows to in a last round for the Steiner points that no cavity
 /// within [`GROW_LIMIT`] moves off the surface. On OpenSCAD's GEB one point on an edge
 /// between two coplanar facets, crowded by the points of nearby recovered segments, stayed
-/// (its star 80 tets); the fill then failed. Only fills that would fail reach this round,
-/// and only with [`Patience::LastResort`].
+/// (its star 80 tets), and the fill failed without this round; since segments stop
+/// being halved near an edge they cross ([`HALVING_DEPTH`]), that point is not made.
+/// Only fills that would fail reach this round, and only with [`Patience::LastResort`].
 const GROW_LIMIT_LAST: usize = 4_000;
 
 /// Step lengths tried for a grown cavity's point: `reach / 2^k` for k in 2..this.
@@ -311,7 +320,11 @@ impl<'a> Cdt<'a> {
                 goals.pop();
                 continue;
             }
-            if self.split == Split::Halving {
+            // Halving, except for a piece that halving has already cut short and that
+            // crosses a mesh edge exactly: split that edge at the crossing instead.
+            let short = dist(self.dt.p(cur), self.dt.p(goal))
+                < dist(self.dt.p(a), self.dt.p(b)) * 0.5f64.powi(HALVING_DEPTH);
+            if self.split == Split::Halving && !(short && self.crosses_an_edge(cur, goal)) {
                 if let Some(s) = self.insert_between(a, b, cur, goal) {
                     goals.push(s);
                     continue;
@@ -396,6 +409,22 @@ impl<'a> Cdt<'a> {
             }
         }
         Err("edge recovery did not end")
+    }
+
+    /// Whether segment `cur`-`goal` leaves `cur` exactly through an edge of the face it
+    /// leaves by (the segment and that edge coplanar and crossing, as the two diagonals
+    /// of a planar quad are).
+    fn crosses_an_edge(&self, cur: u32, goal: u32) -> bool {
+        let Some((t, k)) = self.dt.leaving(cur, goal) else {
+            return false;
+        };
+        let tv = self.dt.tets[t as usize];
+        let fp = FACES[k].map(|j| self.dt.p(tv[j]));
+        let (pc, pb) = (self.dt.p(cur), self.dt.p(goal));
+        (0..3)
+            .filter(|&e| orient3d(pc, pb, fp[e], fp[(e + 1) % 3]) == 0)
+            .count()
+            == 1
     }
 
     /// Insert a point of input edge ab strictly between its points `cur` and `goal`
