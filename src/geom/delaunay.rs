@@ -545,15 +545,11 @@ impl Delaunay {
                     new.push(t);
                 }
             }
-            // Volumes must match the old ones (no overlap): check exactly by sign sum
-            // is not possible; compare floating volumes as a guard.
-            let vol = |t: &[u32; 4]| {
-                let p = t.map(|v| self.p(v));
-                super::vec3::tet_det(p[0], p[1], p[2], p[3])
-            };
-            let old: f64 = around.iter().map(|&t| vol(&self.tets[t as usize])).sum();
-            let newv: f64 = new.iter().map(vol).sum();
-            if (old - newv).abs() <= 1e-9 * old.abs() {
+            // Positive tets with the old tets' boundary tile their region exactly (a fan
+            // triangle turned against the others would make an overlap; a volume
+            // comparison misses one between nearly flat tets).
+            let old: Vec<[u32; 4]> = around.iter().map(|&t| self.tets[t as usize]).collect();
+            if same_boundary(&old, &new) {
                 self.replace(around, &new);
                 return true;
             }
@@ -1002,6 +998,36 @@ impl Delaunay {
     }
 }
 
+/// Whether tets `a` and `b` have the same boundary as oriented triangles (faces shared
+/// inside a set, once each way, cancel). Positive tets with the boundary of a region tile
+/// it: the winding number they add up to at a point is the boundary's, so 1 inside and 0
+/// outside, and a point covered twice or not at all would change it.
+pub(crate) fn same_boundary(a: &[[u32; 4]], b: &[[u32; 4]]) -> bool {
+    // Each oriented face, rotated to start at its smallest vertex, with +1 for set `a`
+    // and -1 for set `b`; a face's reverse counts against it.
+    let mut faces: Vec<([u32; 3], i32)> = Vec::with_capacity(4 * (a.len() + b.len()));
+    for (set, w) in [(a, 1), (b, -1)] {
+        for t in set {
+            for f in FACES {
+                let g = f.map(|j| t[j]);
+                let r = (0..3).min_by_key(|&k| g[k]).unwrap_or(0);
+                let g = [g[r], g[(r + 1) % 3], g[(r + 2) % 3]];
+                // The reverse, also starting at the smallest vertex.
+                let rev = [g[0], g[2], g[1]];
+                if g[1] < g[2] {
+                    faces.push((g, w));
+                } else {
+                    faces.push((rev, -w));
+                }
+            }
+        }
+    }
+    faces.sort_unstable();
+    faces
+        .chunk_by(|x, y| x.0 == y.0)
+        .all(|run| run.iter().map(|x| x.1).sum::<i32>() == 0)
+}
+
 /// Whether oriented triangles close up: every edge on two of them, once each way (the
 /// faces of a cavity, seen from the point that fills it).
 pub(crate) fn closes_up(tris: impl Iterator<Item = [u32; 3]>) -> bool {
@@ -1088,6 +1114,22 @@ mod tests {
         let dt = Delaunay::new(&pts);
         check_delaunay(&dt);
         assert!(dt.interior_tets().count() > 200);
+    }
+
+    /// A 2-3 flip's tets have its two tets' boundary; a tet turned over, or one more
+    /// tet on top (an overlap), does not.
+    #[test]
+    fn same_boundary_compares_oriented_faces() {
+        let old = [[0, 1, 2, 3], [0, 2, 1, 4]];
+        let new = [[0, 2, 3, 4], [2, 1, 3, 4], [1, 0, 3, 4]];
+        assert!(same_boundary(&old, &new));
+        assert!(same_boundary(&new, &old));
+        assert!(!same_boundary(
+            &old,
+            &[[0, 2, 3, 4], [1, 2, 3, 4], [1, 0, 3, 4]]
+        ));
+        assert!(!same_boundary(&old, &[new[0], new[1], new[2], new[0]]));
+        assert!(!same_boundary(&old, &new[..2]));
     }
 
     /// Points inserted one by one into a Delaunay triangulation keep it Delaunay; with
