@@ -407,6 +407,31 @@ mod tests {
         check_whole_fill("tests/data/openscad/example007.stl");
     }
 
+    /// OpenSCAD part `name`'s whole fill with one way (`split`, `patience`), its interior
+    /// candidates those inside only or (`outside`) all: the fill, its stages and the
+    /// points it was given.
+    fn fill_openscad(
+        name: &str,
+        outside: bool,
+        split: Split,
+        patience: Patience,
+    ) -> (
+        Result<cdt_fill::Filled, &'static str>,
+        cdt_fill::Stages,
+        Vec<P3>,
+    ) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("tests/data/openscad/{name}.stl"));
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let size = crate::generate::size_field(&s, &Options::default());
+        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
+        let mut all = inp.pts.clone();
+        all.extend(inp.interior.iter().filter(|p| p.1 || outside).map(|p| p.0));
+        let mut stages = cdt_fill::Stages::default();
+        let r = cdt_fill::fill(&all, &inp.faces, split, None, patience, &mut stages);
+        (r, stages, all)
+    }
+
     /// OpenSCAD's example012 with its interior points: at crossings, 41 of its 1,303
     /// Steiner points stayed on the surface in the first round of moving them off and
     /// the fill gave up ([`Patience::GiveUpEarly`]; the exhaustive search failed too).
@@ -415,23 +440,13 @@ mod tests {
     /// with the exact boundary check every point moves off, at crossings, at once.
     #[test]
     fn crossings_fill_where_edge_removals_kept_their_tets_apart() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/openscad/example012.stl");
-        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-        let size = crate::generate::size_field(&s, &Options::default());
-        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
-        let mut all = inp.pts.clone();
-        all.extend(inp.interior.iter().filter(|p| p.1).map(|p| p.0));
-        let mut stages = cdt_fill::Stages::default();
-        let filled = cdt_fill::fill(
-            &all,
-            &inp.faces,
+        let (r, stages, all) = fill_openscad(
+            "example012",
+            false,
             Split::AtCrossing,
-            None,
             Patience::GiveUpEarly,
-            &mut stages,
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
+        );
+        let filled = r.unwrap_or_else(|e| panic!("{e}"));
         assert!(filled.pts.len() > all.len(), "no Steiner point");
         assert!(stages.steiner_points > 0);
     }
@@ -444,22 +459,7 @@ mod tests {
     /// their crossing once short, every point moves off in the regular rounds.
     #[test]
     fn a_crowded_edge_of_needles_fills_without_larger_cavities() {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad/GEB.stl");
-        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-        let size = crate::generate::size_field(&s, &Options::default());
-        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
-        let mut all = inp.pts.clone();
-        all.extend(inp.interior.iter().map(|p| p.0));
-        let mut stages = cdt_fill::Stages::default();
-        let r = cdt_fill::fill(
-            &all,
-            &inp.faces,
-            Split::Halving,
-            None,
-            Patience::Exhaustive,
-            &mut stages,
-        );
+        let (r, stages, all) = fill_openscad("GEB", true, Split::Halving, Patience::Exhaustive);
         let filled = r.unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(stages.wide_cavity_points, 0);
         assert_eq!(&filled.pts[..all.len()], &all[..]);
@@ -472,23 +472,9 @@ mod tests {
     /// short (`cdt_fill::HALVING_DEPTH`), it fills.
     #[test]
     fn a_segment_crossing_a_coplanar_edge_is_split_there_not_halved_on() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/openscad/CSG-modules.stl");
-        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-        let size = crate::generate::size_field(&s, &Options::default());
-        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
-        let mut all = inp.pts.clone();
-        all.extend(inp.interior.iter().filter(|p| p.1).map(|p| p.0));
-        let mut stages = cdt_fill::Stages::default();
-        let filled = cdt_fill::fill(
-            &all,
-            &inp.faces,
-            Split::Halving,
-            None,
-            Patience::Exhaustive,
-            &mut stages,
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
+        let (r, stages, all) =
+            fill_openscad("CSG-modules", false, Split::Halving, Patience::Exhaustive);
+        let filled = r.unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(&filled.pts[..all.len()], &all[..]);
         assert!(stages.steiner_points > 0);
     }
