@@ -469,7 +469,11 @@ mod tests {
     /// diagonal of a long planar quad of cap vertices crosses the other, a mesh edge,
     /// exactly. Halved on and on, it piled 61 points within 1e-4 of the crossing, two of
     /// which no cavity let off the surface; split at the crossing once its pieces are
-    /// short (`cdt_fill::HALVING_DEPTH`), it fills.
+    /// short (`cdt_fill::HALVING_DEPTH`), it fills. Its caps are planes of needle
+    /// triangles: the Steiner points on them that only a tiny step moved off pinned
+    /// their neighbours to the cap too (34 numerically flat tets, 198 such points,
+    /// and 3 elements the later stages could not certify); deferred to the last round,
+    /// most move off properly.
     #[test]
     fn a_segment_crossing_a_coplanar_edge_is_split_there_not_halved_on() {
         let (r, stages, all) =
@@ -477,6 +481,15 @@ mod tests {
         let filled = r.unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(&filled.pts[..all.len()], &all[..]);
         assert!(stages.steiner_points > 0);
+        let flat = filled
+            .tets
+            .iter()
+            .filter(|t| {
+                crate::geom::tet_quality::numerically_flat(&t.map(|v| filled.pts[v as usize]))
+            })
+            .count();
+        assert!(flat <= 2, "{flat} numerically flat tets");
+        assert!(filled.tiny < 100, "{} points at a tiny step", filled.tiny);
     }
 
     /// The torus (R = 1, r = 0.35, axis z): the candidates inside the tube are marked

@@ -15,8 +15,10 @@
 //!    the triangle's plane, exact 2D orientations) and it is placed along the inward normal where every
 //!    tet of its new star is positive. Where no point is (a nearly flat tet of the star
 //!    at the point: every inward step inverts it), the star grows through the faces a
-//!    point just inside does not see, until it sees them all ([`Cdt::grown_star`]). The
-//!    surface triangles come back exactly.
+//!    point just inside does not see, until it sees them all ([`Cdt::grown_star`]). A
+//!    point that only a tiny step would move off waits for the last round: its
+//!    neighbours may move off meanwhile, which it would pin to the surface. The surface
+//!    triangles come back exactly.
 //! 6. Points off the surface that numerically flat tets use are contracted into a
 //!    neighbour where that leaves fewer of them ([`Cdt::contract_flat`]): Steiner points
 //!    moved off a long segment one at a time stay almost on its line, and the tets
@@ -234,6 +236,11 @@ struct Cdt<'a> {
     grow_limit: usize,
     /// Points that reached the round with [`GROW_LIMIT_LAST`].
     wide_cavity_points: usize,
+    /// Whether [`Cdt::move_off`] leaves a point that only a tiny step would move off the
+    /// surface on it, for a later round (every round but the last, [`Cdt::remove_steiner_points`]).
+    defer_tiny: bool,
+    /// Points deferred so in the current round.
+    deferred: usize,
 }
 
 impl<'a> Cdt<'a> {
@@ -273,6 +280,8 @@ impl<'a> Cdt<'a> {
             grow: false,
             grow_limit: GROW_LIMIT,
             wide_cavity_points: 0,
+            defer_tiny: true,
+            deferred: 0,
         })
     }
 
@@ -704,11 +713,12 @@ impl<'a> Cdt<'a> {
                     break;
                 }
                 let mut stuck = Vec::new();
+                self.deferred = 0;
                 for &(s, n) in &left {
                     let n = self.remove_one(s, n)?;
                     if n > 0 {
                         stuck.push((s, n));
-                        if first_round && stuck.len() > give_up {
+                        if first_round && stuck.len().saturating_sub(self.deferred) > give_up {
                             return Err("too many Steiner points stay on the surface");
                         }
                     }
@@ -721,6 +731,17 @@ impl<'a> Cdt<'a> {
                 }
             }
         }
+        // The points deferred at a tiny step (and any still stuck): one more round that
+        // leaves them there where nothing better is found.
+        self.defer_tiny = false;
+        let mut stuck = Vec::new();
+        for &(s, n) in &left {
+            let n = self.remove_one(s, n)?;
+            if n > 0 {
+                stuck.push((s, n));
+            }
+        }
+        left = stuck;
         // The points still left: one round with far larger cavities, where no other way
         // follows.
         self.wide_cavity_points = left.len();
@@ -1030,6 +1051,14 @@ impl<'a> Cdt<'a> {
                 placed = true;
                 self.grown += 1;
             } else if tiny {
+                if self.defer_tiny {
+                    // Left on the surface until the last round: its neighbours on the
+                    // same face may move off meanwhile, and a point a tiny step off it
+                    // would pin them to the surface too.
+                    self.deferred += 1;
+                    self.dt.pop_point();
+                    return Ok(None);
+                }
                 self.dt.pts[q as usize] = at_tiny_step;
             }
         }
@@ -1749,8 +1778,8 @@ mod tests {
     }
 
     /// OpenSCAD's example018, filled from its boundary points: moving the Steiner points
-    /// off the surface leaves a numerically flat tet whose vertices are not all on the
-    /// surface; contracting one of them into a neighbour removes it, and the fill keeps
+    /// off the surface, tiny steps taken at once, leaves a numerically flat tet whose
+    /// vertices are not all on the surface; contracting one of them into a neighbour removes it, and the fill keeps
     /// its boundary and volume.
     #[test]
     fn contraction_removes_the_flat_tets_moving_off_leaves() {
@@ -1763,6 +1792,9 @@ mod tests {
             Patience::Exhaustive,
         )
         .unwrap();
+        // Points that only a tiny step moves off placed there at once, not deferred to
+        // the last round: the fill then leaves the flat tet (deferred, none).
+        c.defer_tiny = false;
         c.recover_edges().unwrap();
         (0..faces.len())
             .try_for_each(|i| c.recover_face(i))
