@@ -236,10 +236,11 @@ struct Cdt<'a> {
     grow_limit: usize,
     /// Points that reached the round with [`GROW_LIMIT_LAST`].
     wide_cavity_points: usize,
-    /// Whether [`Cdt::move_off`] leaves a point that only a tiny step would move off the
-    /// surface on it, for a later round (every round but the last, [`Cdt::remove_steiner_points`]).
+    /// Whether [`Cdt::move_off`] leaves a point that only a tiny step would move off
+    /// the surface on it, for a later round (every round of
+    /// [`Cdt::remove_steiner_points`] but the last).
     defer_tiny: bool,
-    /// Points deferred so in the current round.
+    /// Points deferred so in the current round ([`Cdt::move_round`]).
     deferred: usize,
 }
 
@@ -712,17 +713,8 @@ impl<'a> Cdt<'a> {
                 if left.is_empty() {
                     break;
                 }
-                let mut stuck = Vec::new();
-                self.deferred = 0;
-                for &(s, n) in &left {
-                    let n = self.remove_one(s, n)?;
-                    if n > 0 {
-                        stuck.push((s, n));
-                        if first_round && stuck.len().saturating_sub(self.deferred) > give_up {
-                            return Err("too many Steiner points stay on the surface");
-                        }
-                    }
-                }
+                let stuck =
+                    self.move_round(&left, if first_round { give_up } else { usize::MAX })?;
                 first_round = false;
                 let progress = stuck.len() < left.len();
                 left = stuck;
@@ -734,33 +726,41 @@ impl<'a> Cdt<'a> {
         // The points deferred at a tiny step (and any still stuck): one more round that
         // leaves them there where nothing better is found.
         self.defer_tiny = false;
-        let mut stuck = Vec::new();
-        for &(s, n) in &left {
-            let n = self.remove_one(s, n)?;
-            if n > 0 {
-                stuck.push((s, n));
-            }
-        }
-        left = stuck;
+        left = self.move_round(&left, usize::MAX)?;
         // The points still left: one round with far larger cavities, where no other way
         // follows.
         self.wide_cavity_points = left.len();
         if self.patience == Patience::LastResort {
             self.grow_limit = GROW_LIMIT_LAST;
-            let mut stuck = Vec::new();
-            for &(s, n) in &left {
-                let n = self.remove_one(s, n)?;
-                if n > 0 {
-                    stuck.push((s, n));
-                }
-            }
-            left = stuck;
+            left = self.move_round(&left, usize::MAX)?;
         }
         if left.is_empty() {
             Ok(())
         } else {
             Err("no interior point sees a Steiner point's star")
         }
+    }
+
+    /// One round of [`Cdt::remove_one`] over the points `left` (each with its pockets);
+    /// returns those still on the surface, or Err once more than `give_up` of them have
+    /// stayed (points deferred at a tiny step not counted).
+    fn move_round(
+        &mut self,
+        left: &[(u32, usize)],
+        give_up: usize,
+    ) -> Result<Vec<(u32, usize)>, &'static str> {
+        let mut stuck = Vec::new();
+        self.deferred = 0;
+        for &(s, n) in left {
+            let n = self.remove_one(s, n)?;
+            if n > 0 {
+                stuck.push((s, n));
+                if stuck.len().saturating_sub(self.deferred) > give_up {
+                    return Err("too many Steiner points stay on the surface");
+                }
+            }
+        }
+        Ok(stuck)
     }
 
     /// Move Steiner point `s` off the surface in each of its `pockets`; returns how many
@@ -1779,8 +1779,8 @@ mod tests {
 
     /// OpenSCAD's example018, filled from its boundary points: moving the Steiner points
     /// off the surface, tiny steps taken at once, leaves a numerically flat tet whose
-    /// vertices are not all on the surface; contracting one of them into a neighbour removes it, and the fill keeps
-    /// its boundary and volume.
+    /// vertices are not all on the surface; contracting one of them into a neighbour
+    /// removes it, and the fill keeps its boundary and volume.
     #[test]
     fn contraction_removes_the_flat_tets_moving_off_leaves() {
         let (pts, outward) = openscad_corners("example018");
