@@ -141,7 +141,8 @@ fn generate_inner(
     let size_value = size.min_size();
     times.size_field = t.elapsed().as_secs_f64();
 
-    let bnd = Boundary::new(surface.nodes().len(), surface.triangles());
+    let bnd = Boundary::new(surface.nodes().len(), surface.triangles())
+        .with_sliver_floors(surface.nodes(), surface.triangles());
     // Front, linear stage, assembly, high-order stage, final check; when the check finds
     // elements the optimizer could not untangle (in a conforming mesh; without the
     // optimizer, a curved tet the front took as a last resort), again from the front's

@@ -551,7 +551,8 @@ mod tests {
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
         let out = whole_fill(s.nodes(), s.triangles(), &size).unwrap();
-        let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles());
+        let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles())
+            .with_sliver_floors(s.nodes(), s.triangles());
         let (pts, tets, _) = improve_linear(out.pts, out.tets, &bnd, prm);
         (pts, tets, bnd)
     }
@@ -561,8 +562,10 @@ mod tests {
     fn interior_slivers_after_linear(path: &str, guard: bool) -> usize {
         use crate::mesh::slivers::is_sliver;
         use crate::optimize::linear::LinearParams;
+        // (Without the sliver passes, which would hide what the guard does.)
         let prm = LinearParams {
             guard_slivers: guard,
+            sliver_passes: 0,
             ..LinearParams::default()
         };
         let (pts, tets, bnd) = fill_then_linear(path, &prm);
@@ -590,17 +593,49 @@ mod tests {
     fn the_flat_passes_leave_fewer_nearly_flat_tets() {
         use crate::optimize::LinearParams;
         let path = "tests/data/openscad/example005.stl";
-        let no_flat_passes = LinearParams {
-            flat_skewness: None,
+        // Without the sliver passes after them, which go after every unforced sliver.
+        let with_flat_passes = LinearParams {
+            sliver_passes: 0,
             ..LinearParams::for_whole_fill()
         };
+        let no_flat_passes = LinearParams {
+            flat_skewness: None,
+            ..with_flat_passes.clone()
+        };
         let without = flat_tets_after_linear(path, &no_flat_passes);
-        let with = flat_tets_after_linear(path, &LinearParams::for_whole_fill());
+        let with = flat_tets_after_linear(path, &with_flat_passes);
         // Measured: 224 without the flat passes, 143 with them.
         assert!(
             4 * with < 3 * without,
             "{with} nearly flat tets off the surface with the flat passes, {without} without"
         );
+    }
+
+    /// The whole fill's linear stage as `generate` runs it, with and without the sliver
+    /// passes: the unforced slivers left (a dihedral angle below the least the sliver
+    /// census allows at the tet's corners).
+    #[test]
+    fn the_sliver_passes_remove_the_unforced_slivers() {
+        use crate::geom::tet_quality::dihedral_extremes;
+        use crate::optimize::LinearParams;
+        let unforced = |prm: &LinearParams| {
+            let (pts, tets, bnd) = fill_then_linear("tests/data/openscad/example002.stl", prm);
+            tets.iter()
+                .filter(|t| {
+                    dihedral_extremes(&t.map(|v| pts[v as usize])).0 < bnd.tet_sliver_floor(**t)
+                })
+                .count()
+        };
+        let without = unforced(&LinearParams {
+            sliver_passes: 0,
+            ..LinearParams::for_whole_fill()
+        });
+        let with = unforced(&LinearParams::for_whole_fill());
+        assert!(
+            without > 10,
+            "{without} unforced slivers without the sliver passes"
+        );
+        assert_eq!(with, 0, "{with} unforced slivers with the sliver passes");
     }
 
     #[test]

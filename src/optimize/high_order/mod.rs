@@ -174,6 +174,8 @@ struct RoundPrm<'p> {
     threshold: f64,
     /// This round's [`HighOrderParams::vertices_below`].
     vertices_below: f64,
+    /// The boundary, for the sliver floors ([`Boundary::tet_sliver_floor`]).
+    bnd: &'p Boundary,
 }
 
 /// What the high-order stage did.
@@ -257,6 +259,7 @@ pub fn optimize_high_order(
         let rp = RoundPrm {
             stage: prm,
             tune,
+            bnd,
             vertices_below: if escalate {
                 prm.threshold
             } else {
@@ -535,6 +538,8 @@ struct PatchJob {
     v: Vec<f64>,
     /// Number of free nodes.
     n_free: usize,
+    /// Each element's sliver floor ([`Boundary::tet_sliver_floor`]).
+    floors: Vec<f64>,
 }
 
 /// The inputs of patch `p` at node positions `x` and element scores `sj`.
@@ -550,6 +555,14 @@ fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &RoundPrm) 
         before_def += (prm.threshold - sj[e as usize]).max(0.0);
         elems.push(PatchElem::new(xe, t.map(var_of)));
     }
+    let floors = p
+        .elems
+        .iter()
+        .map(|&e| {
+            let t = &tets[e as usize];
+            prm.bnd.tet_sliver_floor([t[0], t[1], t[2], t[3]])
+        })
+        .collect();
     // Initial variables: vertex positions, mid offsets from their edge midpoints.
     let mut v = vec![0.0; 3 * p.free.len()];
     for el in &elems {
@@ -575,6 +588,7 @@ fn prepare(tets: &[[u32; 10]], x: &[P3], p: &Patch, sj: &[f64], prm: &RoundPrm) 
         before_def,
         v,
         n_free: p.free.len(),
+        floors,
     }
 }
 
@@ -597,6 +611,7 @@ fn run_patch(
         before_def,
         mut v,
         n_free,
+        floors,
     } = job;
     // Stage A: mid nodes only.
     let mids: Vec<PatchElem> = elems
@@ -646,7 +661,19 @@ fn run_patch(
             };
             // Corner skewness before (`x` of a patch element holds its starting nodes).
             let before_skew = elems.iter().map(|e| skew(&e.x)).fold(0.0f64, f64::max);
-            if better(lo, deficit(&scores), best_min, best_def) && sk <= before_skew.max(cap) {
+            // Unforced slivers (a dihedral angle below the element's sliver floor)
+            // before and after: moving vertices may not make more.
+            let unforced =
+                |x: [P3; 10], f: &f64| dihedral_extremes(&[x[0], x[1], x[2], x[3]]).0 < *f;
+            let before_unforced = elems.iter().zip(&floors).filter(|(e, f)| unforced(e.x, f));
+            let after_unforced = elems
+                .iter()
+                .zip(&floors)
+                .filter(|(e, f)| unforced(nodes(e, &v), f));
+            if better(lo, deficit(&scores), best_min, best_def)
+                && sk <= before_skew.max(cap)
+                && after_unforced.count() <= before_unforced.count()
+            {
                 best = Some((v.clone(), scores.clone()));
             }
         }
@@ -764,11 +791,13 @@ mod tests {
         let mut v: Vec<f64> = offset.iter().chain(&x[3]).copied().collect();
         let before = v.clone();
         let d = HighOrderParams::default();
+        let nb = Boundary::new(0, &[]);
         let prm = RoundPrm {
             stage: &d,
             tune: &d.staged,
             threshold: d.threshold,
             vertices_below: d.vertices_below,
+            bnd: &nb,
         };
         let work = run_barrier(&mids, &mut v, &scale, &prm, &mut Lbfgs::default(), &|| true);
         assert!(work > 0 && v[..3] != before[..3], "the barrier did not run");

@@ -236,11 +236,13 @@ mod tests {
         let base = c.p2_perturbed(5, 0.05);
         let adj = NodeElems::new(&base);
         let stage = crate::optimize::HighOrderParams::default();
+        let nb = crate::optimize::Boundary::new(0, &[]);
         let prm = RoundPrm {
             stage: &stage,
             tune: &stage.staged,
             threshold: stage.threshold,
             vertices_below: stage.vertices_below,
+            bnd: &nb,
         };
         let ne = base.tets.len();
         let mut sj0 = vec![0.0; ne];

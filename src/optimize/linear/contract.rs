@@ -122,6 +122,9 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
     s.touched.extend_from_slice(&m.vt[k as usize]);
     s.touched.sort_unstable();
     s.touched.dedup();
+    if s.touched.iter().any(|&t| m.exempt(t)) {
+        return false;
+    }
     let old = s
         .touched
         .iter()

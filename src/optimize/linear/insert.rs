@@ -39,7 +39,7 @@ pub(super) fn split_edge(
         return false;
     }
     m.edge_tets(a, b, &mut s.ts);
-    if s.ts.len() < 3 {
+    if s.ts.len() < 3 || s.ts.iter().any(|&t| m.exempt(t)) {
         return false;
     }
     let mut old_min = f64::INFINITY;
@@ -54,7 +54,9 @@ pub(super) fn split_edge(
     // screw, 67 of the 101 splits tried; 2,193 of 3,821 on the hinge): the split still
     // runs and is undone as before (its slots, stars and change clocks steer the later
     // passes), but the new vertex is not smoothed, which is what a split costs.
-    let doomed = ruled_out(cut_bound(&m.pts, &m.tets, a, b, &s.ts), old_min + eps);
+    // (The bound is on the element quality, not on the sliver passes' score.)
+    let doomed =
+        !m.sliver_mode() && ruled_out(cut_bound(&m.pts, &m.tets, a, b, &s.ts), old_min + eps);
     let p = mid(m.pts[a as usize], m.pts[b as usize]);
     // The new tets (a, p, u, v) and (p, b, u, v) for each old (a, b, u, v); all must be
     // positive (exact) before anything changes.
@@ -110,7 +112,13 @@ pub(super) fn split_edge(
             .filter(|&&t| sliver(&m.tets[t as usize]));
         after.count() > s.old.iter().filter(|t| sliver(t)).count()
     };
-    if new_min > old_min + eps && (!s.sliver_guard || old_min < 0.0 || !more_slivers()) {
+    // (In the sliver passes, the unforced slivers are the tets scoring below 1.)
+    let guard = s.sliver_guard && !m.sliver_mode();
+    let new_q = m.vt[np as usize].iter().map(|&t| m.q[t as usize]);
+    if new_min > old_min + eps
+        && (!guard || old_min < 0.0 || !more_slivers())
+        && !m.more_unforced(s.old_q.iter().copied(), new_q)
+    {
         return true;
     }
     // Undo: the new vertex stays as an unused point.

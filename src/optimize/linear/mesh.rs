@@ -2,6 +2,7 @@
 //! operations of the linear stage edit.
 
 use super::objective::ElementQuality;
+use crate::geom::tet_quality::dihedral_extremes;
 use crate::geom::vec3::P3;
 use crate::optimize::Boundary;
 
@@ -30,6 +31,10 @@ pub(super) struct LinMesh<'a> {
     pub clock: u64,
     /// Deleted slots, reused by [`LinMesh::add`] (last freed first).
     free: Vec<u32>,
+    /// Score tets by [`LinMesh::sliver_score`] instead of the element quality (the
+    /// sliver passes); every cached quality must be measured again when it changes
+    /// ([`LinMesh::set_sliver_mode`]).
+    sliver_mode: bool,
 }
 
 impl<'a> LinMesh<'a> {
@@ -77,6 +82,7 @@ impl<'a> LinMesh<'a> {
             changed: Vec::new(),
             clock: 1,
             free: Vec::new(),
+            sliver_mode: false,
         };
         m.dirty = vec![true; m.pts.len()];
         m.changed = vec![1; m.pts.len()];
@@ -107,7 +113,7 @@ impl<'a> LinMesh<'a> {
     /// Quality of the tet on `v` with corners at `c`.
     #[inline]
     pub fn quality_at(&self, v: [u32; 4], c: &[P3; 4]) -> f64 {
-        self.eq.eval(self.bnd, &self.pts, v, c)
+        self.quality_above(v, c, f64::NEG_INFINITY)
     }
 
     /// [`LinMesh::quality`] when it is above `floor`, else some value ≤ `floor`.
@@ -119,7 +125,75 @@ impl<'a> LinMesh<'a> {
     /// [`LinMesh::quality_at`] when it is above `floor`, else some value ≤ `floor`.
     #[inline]
     pub fn quality_above(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
+        if self.sliver_mode {
+            return self.sliver_score(v, c, floor);
+        }
         self.eq.eval_above(self.bnd, &self.pts, v, c, floor)
+    }
+
+    /// The sliver passes' score of the tet on `v` with corners at `c`: for a tet the
+    /// element quality scores positive, its smallest dihedral angle over the least the
+    /// sliver census allows there ([`Boundary::tet_sliver_floor`]), at most 1, so that
+    /// below 1 exactly where the census counts an unforced sliver; otherwise (an
+    /// inverted, flat or P2-invalid tet) the element quality's score, ≤ 0. Every tet that
+    /// is not an unforced sliver scores 1: the forced slivers next to needle triangles,
+    /// far worse by the element quality, no longer block the moves that lift an unforced
+    /// one beside them. When the score is ≤ `floor` the value may be any such one.
+    pub fn sliver_score(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
+        let q = self
+            .eq
+            .eval_above(self.bnd, &self.pts, v, c, floor.min(0.0));
+        if q <= 0.0 {
+            return q;
+        }
+        (dihedral_extremes(c).0 / self.bnd.tet_sliver_floor(v)).min(1.0)
+    }
+
+    /// Score tets by [`LinMesh::sliver_score`] (`on`) or by the element quality from now
+    /// on; every cached quality is measured again.
+    pub fn set_sliver_mode(&mut self, on: bool) {
+        self.sliver_mode = on;
+        // Smoothed to a standstill under the other measure is not under this one.
+        self.dirty.iter_mut().for_each(|d| *d = true);
+        for i in 0..self.tets.len() {
+            if self.alive(i as u32) {
+                self.q[i] = self.quality(self.tets[i]);
+            }
+        }
+    }
+
+    /// Whether tet `t` is exempt from the minimum an operation must raise: in the sliver
+    /// passes, a tet that is not valid as a P2 element however its interior mid nodes are
+    /// placed (scored in [−1, −0.5]). The straightening after the high-order stage makes
+    /// such tets valid. A vertex move may not make one worse, and the flips, contractions
+    /// and splits leave them alone: counted in the minimum, they would let an operation
+    /// that lifts one a little make unforced slivers, or block every move of their
+    /// corners that lifts an unforced sliver beside them.
+    #[inline]
+    pub fn exempt(&self, t: u32) -> bool {
+        let q = self.q[t as usize];
+        self.sliver_mode && q < 0.0 && q > f64::NEG_INFINITY
+    }
+
+    /// Whether an edge split that replaces tets scoring `old` by tets scoring `new`
+    /// makes more unforced slivers than it removes: in the sliver passes, more tets
+    /// scoring below 1. Lifting the minimum alone let the passes split one sliver into
+    /// several better ones, pass after pass. (Asked of the splits only: refusing flips,
+    /// contractions and vertex moves that make more left more slivers in the end.)
+    pub fn more_unforced(
+        &self,
+        old: impl IntoIterator<Item = f64>,
+        new: impl IntoIterator<Item = f64>,
+    ) -> bool {
+        let below = |q: &f64| *q < 1.0;
+        self.sliver_mode
+            && new.into_iter().filter(below).count() > old.into_iter().filter(below).count()
+    }
+
+    /// Whether tets are scored by [`LinMesh::sliver_score`].
+    #[inline]
+    pub fn sliver_mode(&self) -> bool {
+        self.sliver_mode
     }
 
     /// True for a live tet slot.
@@ -249,6 +323,7 @@ pub(super) fn face_opposite(t: [u32; 4], k: usize) -> [u32; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geom::vec3::mid;
 
     fn parity(p: [u32; 4], t: [u32; 4]) -> bool {
         let idx = p.map(|x| t.iter().position(|&y| y == x).unwrap());
@@ -261,6 +336,65 @@ mod tests {
             }
         }
         inv % 2 == 0
+    }
+
+    /// The sliver score is 1 on a thin tet a needle at its corner forces (while the
+    /// element quality calls it far worse than an interior sliver), below 1 on a sliver
+    /// no needle forces, and is the element quality's on an inverted tet.
+    #[test]
+    fn the_sliver_score_is_below_one_on_unforced_slivers_only() {
+        use crate::geom::predicates::orient3d;
+        use crate::geom::tet_quality::dihedral_extremes;
+        use crate::mesh::slivers::{smallest_angle_deg, SLIVER_DEG};
+        // A needle triangle (smallest angle about 0.57 degrees) with its mid nodes at
+        // the midpoints (straight), then interior points.
+        let (a, b, c) = ([0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 0.1, 0.0]);
+        let mut pts = vec![a, b, c, mid(a, b), mid(b, c), mid(c, a)];
+        let tris = [[0, 1, 2, 3, 4, 5]];
+        let bnd = Boundary::new(6, &tris).with_sliver_floors(&pts, &tris);
+        let needle = smallest_angle_deg([a, b, c]);
+        assert!(needle < 1.0, "{needle}");
+        assert_eq!(bnd.tet_sliver_floor([0, 6, 7, 8]), needle / 2.0);
+        assert_eq!(bnd.tet_sliver_floor([1, 6, 7, 8]), needle / 2.0);
+        assert_eq!(bnd.tet_sliver_floor([6, 7, 8, 9]), SLIVER_DEG);
+        // 6: above the needle; 7..10: an interior sliver (a square's corners, one lifted
+        // a little off their plane).
+        pts.push([7.0, 0.05, 0.2]);
+        pts.extend([
+            [20.0, 0.0, 0.0],
+            [21.0, 0.0, 0.0],
+            [21.0, 1.0, 0.0],
+            [20.0, 1.0, 0.15],
+        ]);
+        let positive = |mut t: [u32; 4]| {
+            let x = t.map(|v| pts[v as usize]);
+            if orient3d(x[0], x[1], x[2], x[3]) < 0 {
+                t.swap(2, 3);
+            }
+            t
+        };
+        let forced = positive([0, 1, 2, 6]);
+        let interior = positive([7, 8, 9, 10]);
+        let mut inverted = interior;
+        inverted.swap(0, 1);
+        let m = LinMesh::new(pts.clone(), vec![forced, interior], &bnd, ElementQuality);
+        let dmin = |t: [u32; 4]| dihedral_extremes(&m.corners(t)).0;
+        let sliver = |t: [u32; 4]| m.sliver_score(t, &m.corners(t), f64::NEG_INFINITY);
+        // The forced one: below 10 degrees but not below half the needle's angle.
+        assert!(
+            (needle / 2.0..SLIVER_DEG).contains(&dmin(forced)),
+            "{}",
+            dmin(forced)
+        );
+        assert!(
+            (0.0..SLIVER_DEG).contains(&dmin(interior)),
+            "{}",
+            dmin(interior)
+        );
+        assert!(m.quality(forced) < m.quality(interior));
+        assert_eq!(sliver(forced), 1.0);
+        assert_eq!(sliver(interior), dmin(interior) / SLIVER_DEG);
+        assert_eq!(sliver(inverted), f64::NEG_INFINITY);
     }
 
     #[test]

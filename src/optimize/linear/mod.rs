@@ -78,6 +78,13 @@ pub struct LinearParams {
     /// whose tets next to the surface are poor and where the splits spread slivers
     /// inward: OpenSCAD's sign made 2,055 interior slivers without it, 1,182 with it.
     pub guard_slivers: bool,
+    /// Last: passes and vertex searches aimed at the unforced slivers only (tets with a
+    /// dihedral angle below [`crate::mesh::slivers::SLIVER_DEG`] that no needle or cap
+    /// triangle at their corners forces; see [`Boundary::sliver_floor`]), scoring every
+    /// other tet as good (a score of 1), so that the forced slivers beside them, worse by
+    /// the element quality, no longer block every move. Up to this many passes, with a
+    /// budget of their own (one attempt per tet of the input); 0: none.
+    pub sliver_passes: usize,
     /// After the passes and searches: passes aimed only at tets above this skewness
     /// (nearly flat), with a budget of their own (one attempt per tet of the input), up
     /// to [`LinearParams::max_passes`]. None: no such passes.
@@ -95,6 +102,7 @@ impl Default for LinearParams {
             reach: 0.05,
             guard_slivers: false,
             flat_skewness: None,
+            sliver_passes: 8,
         }
     }
 }
@@ -244,12 +252,52 @@ pub fn improve_linear_known(
         };
         run_passes(&mut m, &flat, &mut sc, &mut st, &mut order, &mut failed);
     }
+    if prm.sliver_passes > 0 {
+        unforced_sliver_passes(&mut m, prm, &mut sc, &mut st, &mut order);
+    }
     let (w1, b1) = census(&m, goal);
     let (pts, tets) = m.into_parts();
     st.tets[1] = tets.len();
     st.max_skewness[1] = 1.0 - w1;
     st.bad[1] = b1;
     (pts, tets, st)
+}
+
+/// The passes and searches of [`LinearParams::sliver_passes`]: the element quality
+/// gives way to [`LinMesh::sliver_score`], below 1 on the unforced slivers only, and the
+/// passes and searches aim at those (every tet below 1), with a budget of one attempt
+/// per tet of the input on top of what was spent.
+fn unforced_sliver_passes(
+    m: &mut LinMesh,
+    prm: &LinearParams,
+    sc: &mut Scratch,
+    st: &mut LinearStats,
+    order: &mut Vec<(f64, u32, [u32; 4])>,
+) {
+    m.set_sliver_mode(true);
+    if census(m, 1.0).1 > 0 {
+        let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
+        // Goal and search threshold: a score of 1 (skewness 0 in the passes' terms);
+        // no narrowing to the worst (a reach of 1 spans every score below the goal).
+        let p = LinearParams {
+            goal_skewness: 0.0,
+            search_skewness: 0.0,
+            max_passes: prm.sliver_passes,
+            max_attempts_per_tet: spent + 1.0,
+            reach: 1.0,
+            ..prm.clone()
+        };
+        // The clocks of the tets that resisted, by this score.
+        let mut failed = Vec::new();
+        run_passes(m, &p, sc, st, order, &mut failed);
+        for _ in 0..2 {
+            if census(m, 1.0).1 == 0 || !search_worst(m, &p, sc, st, order) {
+                break;
+            }
+            run_passes(m, &p, sc, st, order, &mut failed);
+        }
+    }
+    m.set_sliver_mode(false);
 }
 
 /// Up to `prm.max_passes` passes over the tets below the goal, worst first.
@@ -707,10 +755,12 @@ mod tests {
         assert_eq!(st.attempts, (bound * n as f64) as usize, "{st:?}");
         assert!(st.max_skewness[1] < st.max_skewness[0], "{st:?}");
         assert!(all_positive(&pts2, &tets2));
-        // None allowed (and no sampled search): the mesh is returned as it came.
+        // None allowed (no sampled search, and no sliver passes, which have a budget of
+        // their own): the mesh is returned as it came.
         let prm = LinearParams {
             max_attempts_per_tet: 0.0,
             search_skewness: 1.0,
+            sliver_passes: 0,
             ..LinearParams::default()
         };
         let (pts3, tets3, st) = improve_linear(pts.clone(), c.tets.clone(), &bnd, &prm);

@@ -7,6 +7,7 @@
 
 use super::mesh::LinMesh;
 use super::objective::skew_pieces;
+use crate::geom::tet_quality::EQUIANGULAR_DIHEDRAL_DEG;
 use crate::geom::vec3::{dist2, dot, norm, P3};
 
 /// Tuning of the smoother.
@@ -32,6 +33,10 @@ impl Default for SmoothParams {
         }
     }
 }
+
+/// Halvings of the step the line search makes in the sliver passes (a millionth of the
+/// first step).
+const SLIVER_HALVINGS: usize = 20;
 
 /// Scratch buffers of the smoother.
 #[derive(Default)]
@@ -73,12 +78,21 @@ fn min_norm_point(g: &[[f64; 3]]) -> [f64; 3] {
 /// Minimum quality of the star of `v` with `v` at `p` (each tet's into `qs`); stops early
 /// (returning a value <= `floor`) as soon as some tet is not above `floor`. The values in
 /// `qs` are exact when the result is above `floor` (the only case they are used in).
+/// A tet [`LinMesh::exempt`] from the minimum only may not get worse (−∞ when it does).
 fn star_min(m: &LinMesh, v: u32, star: &[u32], p: P3, floor: f64, qs: &mut Vec<f64>) -> f64 {
     let mut lo = f64::INFINITY;
     qs.clear();
     for &t in star {
         let tv = m.tets[t as usize];
         let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
+        if m.exempt(t) {
+            let q = m.quality_at(tv, &c);
+            qs.push(q);
+            if q < m.q[t as usize] {
+                return f64::NEG_INFINITY;
+            }
+            continue;
+        }
         let q = m.quality_above(tv, &c, floor);
         qs.push(q);
         lo = lo.min(q);
@@ -112,6 +126,7 @@ fn load_star(m: &LinMesh, v: u32, s: &mut SmoothScratch) -> (f64, f64) {
     let qmin = s
         .star
         .iter()
+        .filter(|&&t| !m.exempt(t))
         .map(|&t| m.q[t as usize])
         .fold(f64::INFINITY, f64::min);
     (min_len, qmin)
@@ -133,12 +148,26 @@ pub(super) fn smooth_vertex(
     let max_move = min_len / 3.0;
     let mut last_step = max_move;
     let mut moved = false;
+    // The sliver score of a nearly flat tet is tiny and steep: a piece counts as active
+    // within a fraction of the minimum (an absolute tolerance would make pieces pulling
+    // the other way active and stall the ascent), and the line search may shrink its
+    // step to a millionth.
+    let (halvings, rel_tol) = if m.sliver_mode() {
+        (prm.max_halvings.max(SLIVER_HALVINGS), true)
+    } else {
+        (prm.max_halvings, false)
+    };
     for _ in 0..prm.max_iter {
+        let active_tol = if rel_tol {
+            prm.active_tol.min(0.5 * qmin.max(0.0))
+        } else {
+            prm.active_tol
+        };
         // Active pieces and their gradients.
         s.grads.clear();
         for &t in &s.star {
             let qt = m.q[t as usize];
-            if qt > qmin + prm.active_tol {
+            if qt > qmin + active_tol || m.exempt(t) {
                 // Far from active: only its first-order behaviour matters for the step.
                 continue;
             }
@@ -159,8 +188,20 @@ pub(super) fn smooth_vertex(
                 s.grads.push(g);
                 continue;
             }
+            if m.sliver_mode() {
+                // The sliver score: the smallest dihedral angle over the tet's floor, at
+                // most 1 (the even pieces are θ/θe).
+                let scale = EQUIANGULAR_DIHEDRAL_DEG / m.bnd.tet_sliver_floor(tv);
+                for piece in skew_pieces(&c, k).iter().step_by(2) {
+                    let v = piece.v * scale;
+                    if v < 1.0 && v <= qmin + active_tol {
+                        s.grads.push(piece.g.map(|x| x * scale));
+                    }
+                }
+                continue;
+            }
             for piece in skew_pieces(&c, k) {
-                if piece.v <= qmin + prm.active_tol {
+                if piece.v <= qmin + active_tol {
                     s.grads.push(piece.g);
                 }
             }
@@ -175,7 +216,7 @@ pub(super) fn smooth_vertex(
         }
         let mut alpha = (max_move / dn).min(2.0 * last_step / dn);
         let mut accepted = false;
-        for _ in 0..prm.max_halvings {
+        for _ in 0..halvings {
             let np = [
                 p[0] + alpha * d[0],
                 p[1] + alpha * d[1],
