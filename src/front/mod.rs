@@ -79,6 +79,9 @@ pub struct FrontStats {
     /// The whole fill's tries, in order, the last the one that filled (empty without a
     /// whole fill).
     pub whole_fill_tries: Vec<FillTry>,
+    /// The whole fill ran first, before any front attempt: more than
+    /// [`FILL_FIRST_POOR_FRACTION`] of the surface's triangles are poorly shaped.
+    pub fill_first: bool,
 }
 
 /// One try of the whole fill (`whole_fill`): how it placed Steiner points, with which
@@ -1283,6 +1286,23 @@ fn front_work_budget(surf_tris: usize) -> u64 {
 /// the attempt that succeeded.
 pub const RESTARTS: [(f64, f64); 4] = [(1.0, 1.0), (0.8, 1.0), (1.3, 1.0), (1.0, 0.85)];
 
+/// Above this fraction of poorly shaped surface triangles (aspect ratio above
+/// [`crate::surface::geometry::POOR_ASPECT_RATIO`]) the whole fill runs first, and the
+/// front only where the fill fails ([`run_front`]): every front attempt would stall and
+/// be thrown away. On the OpenSCAD corpus (`../shared/data/openscad`) the front closed
+/// no part above 0.15 (16 parts, 0.155-0.69) and every part it closed is at or below
+/// 0.095 (example014); those 16 spent 0.7-16 s each, about 75 s in all, in front
+/// attempts before the whole fill that meshed them, which gives the same mesh without
+/// them. Raw marching-cubes surfaces (`scripts/marching-cubes.py`) have 0.02-0.05, the
+/// `scripts/aniso-torus.py` tori and the six benchmark surfaces 0-0.001.
+pub const FILL_FIRST_POOR_FRACTION: f64 = 0.15;
+
+/// Whether the whole fill runs before any front attempt ([`FILL_FIRST_POOR_FRACTION`]).
+fn fill_first(surf_nodes: &[P3], surf_tris: &[[u32; 6]]) -> bool {
+    let shape = crate::surface::geometry::triangle_shape(surf_nodes, surf_tris);
+    shape.poor as f64 > FILL_FIRST_POOR_FRACTION * surf_tris.len() as f64
+}
+
 /// [`MAX_REPAIRS_WITHOUT_PROGRESS`] for attempt `attempt` ([`RESTARTS`]), except the last:
 /// with nothing left to restart with, it keeps going until the per-region or overall
 /// limits (a cycling attempt occasionally closes: 30 x 50's second went 66 repairs without
@@ -1322,6 +1342,15 @@ pub fn run_front(
     let mut last_partial = None;
     // The whole fill's error, once it has been tried.
     let mut fill_failed: Option<String> = None;
+    if first == 0 && fill_first(surf_nodes, surf_tris) {
+        match whole_fill_stage(surf_nodes, surf_tris, opts, size, progress)? {
+            Ok(mut out) => {
+                out.stats.fill_first = true;
+                return Ok(out);
+            }
+            Err(why) => fill_failed = Some(why),
+        }
+    }
     // Front work spent by the attempts so far (see `front_work_budget`).
     let mut spent = 0u64;
     let attempts = if front_enabled() {
