@@ -48,12 +48,13 @@ pub fn smallest_angle_deg(p: [P3; 3]) -> f64 {
     best
 }
 
-/// The census of `m`'s straight-sided (corner) tets against its boundary triangles.
-pub fn census(m: &TetMesh) -> SliverCensus {
-    // Per node: the smallest small angle of a boundary triangle at it, and that triangle.
-    let mut at: Vec<(f64, usize)> = vec![(f64::INFINITY, usize::MAX); m.nodes.len()];
-    for (i, t) in m.boundary.iter().enumerate() {
-        let a = smallest_angle_deg([t[0], t[1], t[2]].map(|v| m.nodes[v as usize]));
+/// Per node of `nodes`: the smallest angle below [`SMALL_ANGLE_DEG`] of a triangle of
+/// `tris` (corners first) at it, and that triangle's index; (∞, `usize::MAX`) where
+/// there is none.
+pub fn small_angles_at(nodes: &[P3], tris: &[[u32; 6]]) -> Vec<(f64, usize)> {
+    let mut at = vec![(f64::INFINITY, usize::MAX); nodes.len()];
+    for (i, t) in tris.iter().enumerate() {
+        let a = smallest_angle_deg([t[0], t[1], t[2]].map(|v| nodes[v as usize]));
         if a < SMALL_ANGLE_DEG {
             for &v in &t[..3] {
                 if a < at[v as usize].0 {
@@ -62,6 +63,23 @@ pub fn census(m: &TetMesh) -> SliverCensus {
             }
         }
     }
+    at
+}
+
+/// The smallest dihedral angle (degrees) of a tet that is not an unforced sliver, given
+/// the smallest small angle `theta` at its corners ([`small_angles_at`]; ∞ for none):
+/// half of it, or [`SLIVER_DEG`].
+pub fn sliver_floor(theta: f64) -> f64 {
+    if theta < SMALL_ANGLE_DEG {
+        theta / 2.0
+    } else {
+        SLIVER_DEG
+    }
+}
+
+/// The census of `m`'s straight-sided (corner) tets against its boundary triangles.
+pub fn census(m: &TetMesh) -> SliverCensus {
+    let at = small_angles_at(&m.nodes, &m.boundary);
     let mut c = SliverCensus::default();
     for t in &m.tets {
         let p = [t[0], t[1], t[2], t[3]].map(|v| m.nodes[v as usize]);
@@ -77,7 +95,7 @@ pub fn census(m: &TetMesh) -> SliverCensus {
                     (f64::INFINITY, usize::MAX),
                     |a, b| if b.0 < a.0 { b } else { a },
                 );
-        if tri != usize::MAX && mn >= theta / 2.0 {
+        if mn >= sliver_floor(theta) {
             c.forced += 1;
             if c.worst_forcing_triangle.map_or(true, |w| theta < w.1) {
                 c.worst_forcing_triangle = Some((tri, theta));

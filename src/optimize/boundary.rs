@@ -3,7 +3,7 @@
 
 use crate::geom::shape::{TET10_EDGES, TRI6_EDGES};
 use crate::geom::vec3::{mid, P3};
-use crate::mesh::slivers::{smallest_angle_deg, SLIVER_DEG, SMALL_ANGLE_DEG};
+use crate::mesh::slivers::{sliver_floor, small_angles_at, SLIVER_DEG};
 use rustc_hash::FxHashMap as HashMap;
 
 /// The boundary of the domain as the optimizer sees it.
@@ -14,9 +14,9 @@ pub struct Boundary {
     /// Boundary edge (smaller id, larger id) → its mid node (a surface node).
     pub edge_mid: HashMap<(u32, u32), u32>,
     /// Per surface node, the smallest dihedral angle (degrees) a tet touching it may
-    /// have without counting as an unforced sliver ([`crate::mesh::slivers`]): half the
-    /// smallest angle of a boundary triangle at it when that is below
-    /// [`SMALL_ANGLE_DEG`], else [`SLIVER_DEG`]. Empty: [`SLIVER_DEG`] everywhere
+    /// have without counting as an unforced sliver ([`crate::mesh::slivers::sliver_floor`]):
+    /// half the smallest angle of a boundary triangle at it when that is below
+    /// [`crate::mesh::slivers::SMALL_ANGLE_DEG`], else [`SLIVER_DEG`]. Empty: [`SLIVER_DEG`] everywhere
     /// ([`Boundary::with_sliver_floors`] fills it).
     pub sliver_floor: Vec<f64>,
 }
@@ -42,17 +42,10 @@ impl Boundary {
     /// With [`Boundary::sliver_floor`] measured on the surface nodes `nodes` and the
     /// triangles `tris` (the same as [`Boundary::new`]'s), as the sliver census does.
     pub fn with_sliver_floors(mut self, nodes: &[P3], tris: &[[u32; 6]]) -> Boundary {
-        let mut floor = vec![SLIVER_DEG; self.n_surf];
-        for t in tris {
-            let a = smallest_angle_deg([t[0], t[1], t[2]].map(|v| nodes[v as usize]));
-            if a < SMALL_ANGLE_DEG {
-                for &v in &t[..3] {
-                    let f = &mut floor[v as usize];
-                    *f = f.min(a / 2.0);
-                }
-            }
-        }
-        self.sliver_floor = floor;
+        self.sliver_floor = small_angles_at(nodes, tris)
+            .into_iter()
+            .map(|(theta, _)| sliver_floor(theta))
+            .collect();
         self
     }
 
