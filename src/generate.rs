@@ -174,10 +174,13 @@ fn generate_inner(
                 front.tets,
                 Some(&front.quality),
                 &bnd,
-                &if front.stats.whole_fill {
-                    LinearParams::for_whole_fill()
-                } else {
-                    LinearParams::default()
+                &LinearParams {
+                    chords: surface.chords_allowed(),
+                    ..if front.stats.whole_fill {
+                        LinearParams::for_whole_fill()
+                    } else {
+                        LinearParams::default()
+                    }
                 },
             );
             ostats.linear = st;

@@ -85,13 +85,31 @@ impl Boundary {
     /// some boundary mid node is off its chord midpoint (a curved tet).
     #[inline]
     pub fn tet10(&self, pts: &[P3], v: [u32; 4], c: &[P3; 4]) -> ([P3; 10], bool) {
+        self.tet10_with(pts, v, c, |_| false)
+    }
+
+    /// [`Boundary::tet10`] with the boundary edges (smaller id, larger id) for which
+    /// `on_chord` is true taken straight, as if their mid nodes were back on their
+    /// chords.
+    #[inline]
+    pub fn tet10_with(
+        &self,
+        pts: &[P3],
+        v: [u32; 4],
+        c: &[P3; 4],
+        on_chord: impl Fn((u32, u32)) -> bool,
+    ) -> ([P3; 10], bool) {
         let mut x = [[0.0; 3]; 10];
         x[..4].copy_from_slice(c);
         let mut curved = false;
         for (k, [i, j]) in TET10_EDGES.iter().enumerate() {
             let m = mid(c[*i], c[*j]);
             x[4 + k] = m;
-            if let Some(n) = self.edge_mid(v[*i], v[*j]) {
+            let (a, b) = (v[*i], v[*j]);
+            if let Some(n) = self.edge_mid(a, b) {
+                if on_chord((a.min(b), a.max(b))) {
+                    continue;
+                }
                 let p = pts[n as usize];
                 if p != m {
                     x[4 + k] = p;

@@ -10,6 +10,7 @@ use crate::optimize::Boundary;
 pub(super) const DEAD: [u32; 4] = [u32::MAX; 4];
 
 /// Tets (positive corner order) with cached qualities and vertex stars.
+#[derive(Clone)]
 pub(super) struct LinMesh<'a> {
     /// Point positions (surface nodes first; only interior ones ever change).
     pub pts: Vec<P3>,
@@ -35,6 +36,10 @@ pub(super) struct LinMesh<'a> {
     /// sliver passes); every cached quality must be measured again when it changes
     /// ([`LinMesh::set_sliver_mode`]).
     sliver_mode: bool,
+    /// Boundary edges (smaller id, larger id) that [`LinMesh::sliver_score`] takes
+    /// straight: those the straightening after the high-order stage will put back on
+    /// their chords (see [`super::LinearParams::chords`]).
+    pub chorded: rustc_hash::FxHashSet<(u32, u32)>,
 }
 
 impl<'a> LinMesh<'a> {
@@ -83,6 +88,7 @@ impl<'a> LinMesh<'a> {
             clock: 1,
             free: Vec::new(),
             sliver_mode: false,
+            chorded: Default::default(),
         };
         m.dirty = vec![true; m.pts.len()];
         m.changed = vec![1; m.pts.len()];
@@ -138,11 +144,18 @@ impl<'a> LinMesh<'a> {
     /// inverted, flat or P2-invalid tet) the element quality's score, ≤ 0. Every tet that
     /// is not an unforced sliver scores 1: the forced slivers next to needle triangles,
     /// far worse by the element quality, no longer block the moves that lift an unforced
-    /// one beside them. When the score is ≤ `floor` the value may be any such one.
+    /// one beside them. The boundary edges in [`LinMesh::chorded`] are taken straight.
+    /// When the score is ≤ `floor` the value may be any such one.
     pub fn sliver_score(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
-        let q = self
-            .eq
-            .eval_above(self.bnd, &self.pts, v, c, floor.min(0.0));
+        let q = if self.chorded.is_empty() {
+            self.eq
+                .eval_above(self.bnd, &self.pts, v, c, floor.min(0.0))
+        } else {
+            self.eq
+                .eval_above_with(self.bnd, &self.pts, v, c, floor.min(0.0), |e| {
+                    self.chorded.contains(&e)
+                })
+        };
         if q <= 0.0 {
             return q;
         }

@@ -84,11 +84,20 @@ pub struct LinearParams {
     /// other tet as good (a score of 1), so that the forced slivers beside them, worse by
     /// the element quality, no longer block every move. Up to this many passes in all, in
     /// rounds of eight each followed by vertex searches, while a round removes some,
-    /// with a budget of their own (two attempts per tet of the input); 0: none. The
-    /// rounds keep removing them slowly on large fills: OpenSCAD's example019 went from
-    /// 14,106 to 4,352, 2,979, 2,280, 1,732 and 1,415 in five rounds (2,787 after 24
-    /// passes in three calls before), its linear stage taking 69 s either way.
+    /// with a budget of their own (two attempts per tet of the input); 0: none; the mesh
+    /// of the round that left the fewest is kept. The rounds keep removing them slowly
+    /// on large fills: OpenSCAD's example019 went from 14,106 to 4,352, 2,979, 2,280,
+    /// 1,732, 1,415, 997, 946, 897 and 839 in ten rounds, then 845 (a cap of 40 passes
+    /// stopped it at 1,415; the five rounds more took 8 s of its 63 s stage).
     pub sliver_passes: usize,
+    /// The surface's boundary edges may go back on their chords (a surface curved from
+    /// a linear one, [`crate::Surface::chords_allowed`]): the straightening after the
+    /// high-order stage then puts every curved boundary edge of a tet it cannot certify
+    /// on its chord. The sliver passes take the curved boundary edges of the tets that
+    /// are not valid as P2 elements when they start as those chords already, so that
+    /// they lift such a tet's straight shape, which is what the mesh will keep, rather
+    /// than leave it alone (it is [`LinMesh::exempt`] otherwise).
+    pub chords: bool,
     /// After the passes and searches: passes aimed only at tets above this skewness
     /// (nearly flat), with a budget of their own (one attempt per tet of the input), up
     /// to [`LinearParams::max_passes`]. None: no such passes.
@@ -106,7 +115,8 @@ impl Default for LinearParams {
             reach: 0.05,
             guard_slivers: false,
             flat_skewness: None,
-            sliver_passes: 40,
+            sliver_passes: 120,
+            chords: false,
         }
     }
 }
@@ -278,6 +288,9 @@ fn unforced_sliver_passes(
     st: &mut LinearStats,
     order: &mut Vec<(f64, u32, [u32; 4])>,
 ) {
+    if prm.chords {
+        m.chorded = doomed_edges(m);
+    }
     m.set_sliver_mode(true);
     if census(m, 1.0).1 > 0 {
         let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
@@ -294,6 +307,10 @@ fn unforced_sliver_passes(
         let mut failed = Vec::new();
         // Rounds of passes, each followed by vertex searches, while a round removes some.
         let mut left = census(m, 1.0).1;
+        // The mesh with the fewest so far: a round's max-min moves can make new ones
+        // elsewhere, and the round that ends the rounds often leaves more than the one
+        // before it (OpenSCAD's example010: 25, then 36).
+        let mut best = (left, m.clone());
         let mut passes = 0;
         while left > 0 && passes < prm.sliver_passes {
             let round = LinearParams {
@@ -307,13 +324,50 @@ fn unforced_sliver_passes(
                 search_worst(m, &p, sc, st, order);
             }
             let now = census(m, 1.0).1;
+            if now < best.0 {
+                best = (now, m.clone());
+            }
             if now >= left {
                 break;
             }
             left = now;
         }
+        if census(m, 1.0).1 > best.0 {
+            *m = best.1;
+        }
     }
+    m.chorded.clear();
     m.set_sliver_mode(false);
+}
+
+/// The curved boundary edges of the positive tets that the element quality scores as
+/// not valid P2 elements (≤ 0): the straightening after the high-order stage puts them
+/// on their chords unless something makes those tets valid first
+/// ([`LinearParams::chords`]).
+fn doomed_edges(m: &LinMesh) -> rustc_hash::FxHashSet<(u32, u32)> {
+    use crate::geom::predicates::orient3d;
+    use crate::geom::tet_quality::numerically_flat;
+    let mut out = rustc_hash::FxHashSet::default();
+    for (t, &q) in m.q.iter().enumerate() {
+        if q > 0.0 || !m.alive(t as u32) {
+            continue;
+        }
+        let tv = m.tets[t];
+        let c = m.corners(tv);
+        if orient3d(c[0], c[1], c[2], c[3]) <= 0 || numerically_flat(&c) {
+            continue;
+        }
+        for [i, j] in TET10_EDGES {
+            let (a, b) = (tv[i], tv[j]);
+            if let Some(n) = m.bnd.edge_mid(a, b) {
+                let mid = crate::geom::vec3::mid(c[i], c[j]);
+                if m.pts[n as usize] != mid {
+                    out.insert((a.min(b), a.max(b)));
+                }
+            }
+        }
+    }
+    out
 }
 
 /// Most passes of a round of [`LinearParams::sliver_passes`] before its vertex searches.

@@ -56,6 +56,21 @@ impl ElementQuality {
         c: &[P3; 4],
         floor: f64,
     ) -> f64 {
+        self.eval_above_with(bnd, pts, v, c, floor, |_| false)
+    }
+
+    /// [`ElementQuality::eval_above`] with the boundary edges for which `on_chord` is
+    /// true taken straight ([`Boundary::tet10_with`]).
+    #[inline]
+    pub fn eval_above_with(
+        &self,
+        bnd: &Boundary,
+        pts: &[P3],
+        v: [u32; 4],
+        c: &[P3; 4],
+        floor: f64,
+        on_chord: impl Fn((u32, u32)) -> bool,
+    ) -> f64 {
         // A numerically flat tet scores as an inverted one: its Jacobian cannot be
         // certified, so the stage never makes one and works to remove those it is given.
         if orient3d(c[0], c[1], c[2], c[3]) <= 0 || numerically_flat(c) {
@@ -71,7 +86,7 @@ impl ElementQuality {
         }
         let nb = v.iter().filter(|&&x| bnd.is_fixed(x)).count();
         if nb >= 2 {
-            let (x, curved) = bnd.tet10(pts, v, c);
+            let (x, curved) = bnd.tet10_with(pts, v, c, on_chord);
             if !curved {
                 return 1.0 - s;
             }
