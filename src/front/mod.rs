@@ -80,7 +80,8 @@ pub struct FrontStats {
     /// whole fill).
     pub whole_fill_tries: Vec<FillTry>,
     /// The whole fill ran first, before any front attempt: more than
-    /// [`FILL_FIRST_POOR_FRACTION`] of the surface's triangles are poorly shaped.
+    /// [`FILL_FIRST_POOR_FRACTION`] of the surface's triangles are poorly shaped, or one
+    /// has an aspect ratio above [`FILL_FIRST_WORST_ASPECT_RATIO`].
     pub fill_first: bool,
 }
 
@@ -1297,10 +1298,22 @@ pub const RESTARTS: [(f64, f64); 4] = [(1.0, 1.0), (0.8, 1.0), (1.3, 1.0), (1.0,
 /// `scripts/aniso-torus.py` tori and the six benchmark surfaces 0-0.001.
 pub const FILL_FIRST_POOR_FRACTION: f64 = 0.15;
 
-/// Whether the whole fill runs before any front attempt ([`FILL_FIRST_POOR_FRACTION`]).
+/// Above this largest aspect ratio of a surface triangle the whole fill runs first too
+/// ([`run_front`]): the front has never closed a surface with such a needle. On the
+/// OpenSCAD corpus (`../shared/data/openscad`) the parts the front closes have none
+/// above 234 (example014), and the four others without enough poorly shaped triangles
+/// for [`FILL_FIRST_POOR_FRACTION`] but with a needle above 1,000 (example006, example010,
+/// logo, logo_and_text: 1,464-49,287) spent 3-12 s each in front attempts that were then
+/// thrown away; the fill's mesh is the same without them. Raw marching-cubes surfaces
+/// reach 1,230 (`tests/data/mc_blob.off`), and the front closes none of those either.
+pub const FILL_FIRST_WORST_ASPECT_RATIO: f64 = 1000.0;
+
+/// Whether the whole fill runs before any front attempt ([`FILL_FIRST_POOR_FRACTION`],
+/// [`FILL_FIRST_WORST_ASPECT_RATIO`]).
 fn fill_first(surf_nodes: &[P3], surf_tris: &[[u32; 6]]) -> bool {
     let shape = crate::surface::geometry::triangle_shape(surf_nodes, surf_tris);
     shape.poor as f64 > FILL_FIRST_POOR_FRACTION * surf_tris.len() as f64
+        || shape.worst > FILL_FIRST_WORST_ASPECT_RATIO
 }
 
 /// [`MAX_REPAIRS_WITHOUT_PROGRESS`] for attempt `attempt` ([`RESTARTS`]), except the last:
@@ -1453,6 +1466,26 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join(format!("tests/data/{name}_p2.msh"));
         crate::io::read_any_surface(&path, &Default::default()).expect(name)
+    }
+
+    /// A raw marching-cubes surface has few poorly shaped triangles (101 of 2,316) but a
+    /// needle above [`FILL_FIRST_WORST_ASPECT_RATIO`] (1,230): the whole fill runs
+    /// first. The benchmark surfaces go to the front.
+    #[test]
+    fn a_surface_with_an_extreme_needle_goes_to_the_whole_fill_first() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mc_blob.off");
+        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
+        let shape = crate::surface::geometry::triangle_shape(s.nodes(), s.triangles());
+        assert!(
+            (shape.poor as f64) < FILL_FIRST_POOR_FRACTION * s.triangles().len() as f64,
+            "{shape:?}"
+        );
+        assert!(shape.worst > FILL_FIRST_WORST_ASPECT_RATIO, "{shape:?}");
+        assert!(fill_first(s.nodes(), s.triangles()));
+        for name in ["sphere", "torus", "tube", "lv", "screw", "hinge"] {
+            let s = data_surface(name);
+            assert!(!fill_first(s.nodes(), s.triangles()), "{name}");
+        }
     }
 
     /// The whole fill's tets go through the linear and high-order stages and the final
