@@ -91,12 +91,12 @@ pub struct LinearParams {
     /// stopped it at 1,415; the five rounds more took 8 s of its 63 s stage).
     pub sliver_passes: usize,
     /// The surface's boundary edges may go back on their chords (a surface curved from
-    /// a linear one, [`crate::Surface::chords_allowed`]): the straightening after the
+    /// a linear one, `Surface::chords_allowed`): the straightening after the
     /// high-order stage then puts every curved boundary edge of a tet it cannot certify
     /// on its chord. The sliver passes take the curved boundary edges of the tets that
     /// are not valid as P2 elements when they start as those chords already, so that
     /// they lift such a tet's straight shape, which is what the mesh will keep, rather
-    /// than leave it alone (it is [`LinMesh::exempt`] otherwise).
+    /// than leave it alone, as they do otherwise.
     pub chords: bool,
     /// After the passes and searches: passes aimed only at tets above this skewness
     /// (nearly flat), with a budget of their own (one attempt per tet of the input), up
