@@ -147,15 +147,11 @@ impl<'a> LinMesh<'a> {
     /// one beside them. The boundary edges in [`LinMesh::chorded`] are taken straight.
     /// When the score is ≤ `floor` the value may be any such one.
     pub fn sliver_score(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
-        let q = if self.chorded.is_empty() {
-            self.eq
-                .eval_above(self.bnd, &self.pts, v, c, floor.min(0.0))
-        } else {
-            self.eq
-                .eval_above_with(self.bnd, &self.pts, v, c, floor.min(0.0), |e| {
-                    self.chorded.contains(&e)
-                })
-        };
+        let q = self
+            .eq
+            .eval_above_with(self.bnd, &self.pts, v, c, floor.min(0.0), |e| {
+                self.chorded.contains(&e)
+            });
         if q <= 0.0 {
             return q;
         }

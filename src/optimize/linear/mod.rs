@@ -340,10 +340,10 @@ fn unforced_sliver_passes(
     m.set_sliver_mode(false);
 }
 
-/// The curved boundary edges of the positive tets that the element quality scores as
-/// not valid P2 elements (≤ 0): the straightening after the high-order stage puts them
-/// on their chords unless something makes those tets valid first
-/// ([`LinearParams::chords`]).
+/// The boundary edges of the positive tets that the element quality scores as not
+/// valid P2 elements (≤ 0): the straightening after the high-order stage puts them on
+/// their chords unless something makes those tets valid first ([`LinearParams::chords`]).
+/// (A straight one among them is its own chord: taking it as one changes nothing.)
 fn doomed_edges(m: &LinMesh) -> rustc_hash::FxHashSet<(u32, u32)> {
     use crate::geom::predicates::orient3d;
     use crate::geom::tet_quality::numerically_flat;
@@ -359,11 +359,8 @@ fn doomed_edges(m: &LinMesh) -> rustc_hash::FxHashSet<(u32, u32)> {
         }
         for [i, j] in TET10_EDGES {
             let (a, b) = (tv[i], tv[j]);
-            if let Some(n) = m.bnd.edge_mid(a, b) {
-                let mid = crate::geom::vec3::mid(c[i], c[j]);
-                if m.pts[n as usize] != mid {
-                    out.insert((a.min(b), a.max(b)));
-                }
+            if m.bnd.is_boundary_edge(a, b) {
+                out.insert((a.min(b), a.max(b)));
             }
         }
     }
