@@ -897,7 +897,7 @@ impl Delaunay {
     /// The faces segment ab crosses, walking from a's tet toward b: (tet, local face) in
     /// order. Stops early (returns what it has) where the segment meets an edge or a
     /// vertex (a degenerate crossing).
-    fn crossed_faces(&self, a: u32, b: u32) -> Vec<(u32, usize)> {
+    pub(crate) fn crossed_faces(&self, a: u32, b: u32) -> Vec<(u32, usize)> {
         let (pa, pb) = (self.p(a), self.p(b));
         let Some((mut t, mut k)) = self.leaving(a, b) else {
             return Vec::new();
