@@ -24,7 +24,11 @@
 //! 6. Points off the surface that numerically flat tets use are contracted into a
 //!    neighbour where that leaves fewer of them ([`Cdt::contract_flat`]): Steiner points
 //!    moved off a long segment one at a time stay almost on its line, and the tets
-//!    between them are flatter than the later stages can certify or repair.
+//!    between them are flatter than the later stages can certify or repair. After halving
+//!    ([`Split::Halving`]), so are the Steiner points of tets with a dihedral angle below
+//!    [`SLIVER_CONTRACT_DEG`] where that raises their star's smallest angle
+//!    ([`Cdt::contract_slivers`]): halving leaves many points just off the surface, whose
+//!    slivers the linear stage could not lift.
 //!
 //! Every topological decision is an exact orient3d/orient2d; the Steiner coordinates are
 //! rounded, which the final checks cover: the boundary faces must be the input triangles
@@ -45,8 +49,9 @@ pub(crate) struct Filled {
     /// the tests show that path runs by it.
     #[cfg_attr(not(test), allow(dead_code))]
     pub grown: usize,
-    /// Steiner points left at a tiny step off the surface ([`TINY_STEP`]): no grown
-    /// cavity was seen from a larger one.
+    /// Steiner points left at a tiny step off the surface ([`TINY_STEP`]) that the fill
+    /// keeps: no grown cavity was seen from a larger one, and no contraction removed
+    /// them ([`Cdt::contract_slivers`]).
     #[cfg_attr(not(test), allow(dead_code))]
     pub tiny: usize,
 }
@@ -122,6 +127,9 @@ pub(crate) fn fill_from(
     stages.wide_cavity_points = c.wide_cavity_points;
     r?;
     c.contract_flat();
+    if split == Split::Halving {
+        c.contract_slivers();
+    }
     if let Some(h) = height {
         c.lift_flat_tets(h);
     }
@@ -134,6 +142,10 @@ pub(crate) fn fill_from(
 /// lifting where the apex is within a quarter edge of the face's plane, 8; below 10°,
 /// 10; below 20°, none.
 const LIFT_BELOW_DEG: f64 = 20.0;
+
+/// Tets below this smallest dihedral angle (degrees) with a Steiner point off the surface
+/// get [`Cdt::contract_slivers`].
+const SLIVER_CONTRACT_DEG: f64 = 5.0;
 
 /// Rounds of [`Cdt::contract_flat`].
 const CONTRACT_ROUNDS: usize = 8;
@@ -237,7 +249,7 @@ struct Cdt<'a> {
     /// Steiner points moved off with a grown cavity.
     grown: usize,
     /// Steiner points left at a tiny step.
-    tiny: usize,
+    tiny: Vec<u32>,
     /// Whether [`Cdt::move_off`] may grow a cavity (the last rounds only).
     grow: bool,
     /// Most tets a grown cavity may have ([`GROW_LIMIT`], then [`GROW_LIMIT_LAST`]).
@@ -285,7 +297,7 @@ impl<'a> Cdt<'a> {
             split,
             patience,
             grown: 0,
-            tiny: 0,
+            tiny: Vec::new(),
             grow: false,
             grow_limit: GROW_LIMIT,
             wide_cavity_points: 0,
@@ -1114,7 +1126,7 @@ impl<'a> Cdt<'a> {
             }
         }
         if tiny && self.dt.pts[q as usize] == at_tiny_step && dist(at_tiny_step, ps) < limit {
-            self.tiny += 1;
+            self.tiny.push(q);
         }
         if !placed {
             self.dt.pop_point();
@@ -1264,6 +1276,53 @@ impl<'a> Cdt<'a> {
     /// numerically flat tets, fewer than its star has, then the largest smallest dihedral
     /// angle; false (nothing changed) when none does.
     fn contract_point(&mut self, q: u32) -> bool {
+        self.contract_point_by(q, false)
+    }
+
+    /// Points off the surface added by the recovery (Steiner points) that a tet with a
+    /// dihedral angle below [`SLIVER_CONTRACT_DEG`] uses: contracted into the neighbour
+    /// that raises their star's smallest dihedral angle most, without more numerically
+    /// flat tets; a few rounds while some point goes.
+    fn contract_slivers(&mut self) {
+        let surface: HashSet<u32> = self.faces.iter().flatten().copied().collect();
+        let first_steiner = self.dt.n as u32 + 4;
+        for _ in 0..CONTRACT_ROUNDS {
+            let mut cand: Vec<u32> = Vec::new();
+            for t in 0..self.dt.tets.len() {
+                if !self.dt.alive[t] {
+                    continue;
+                }
+                let tv = self.dt.tets[t];
+                if tv
+                    .iter()
+                    .all(|&v| v < first_steiner || surface.contains(&v))
+                {
+                    continue;
+                }
+                let c = tv.map(|v| self.dt.p(v));
+                if numerically_flat(&c) || dihedral_extremes(&c).0 < SLIVER_CONTRACT_DEG {
+                    cand.extend(
+                        tv.iter()
+                            .copied()
+                            .filter(|&v| v >= first_steiner && !surface.contains(&v)),
+                    );
+                }
+            }
+            cand.sort_unstable();
+            cand.dedup();
+            let mut changed = 0;
+            for q in cand {
+                if !self.dt.star(q).is_empty() && self.contract_point_by(q, true) {
+                    changed += 1;
+                }
+            }
+            if changed == 0 {
+                break;
+            }
+        }
+    }
+
+    fn contract_point_by(&mut self, q: u32, by_angle: bool) -> bool {
         let star = self.dt.star(q);
         let old: Vec<[u32; 4]> = star.iter().map(|&t| self.dt.tets[t as usize]).collect();
         let shape = |dt: &Delaunay, tets: &[[u32; 4]]| {
@@ -1279,7 +1338,7 @@ impl<'a> Cdt<'a> {
             }
             (flat, lo)
         };
-        let (flat0, _) = shape(&self.dt, &old);
+        let (flat0, lo0) = shape(&self.dt, &old);
         // The star's outer faces.
         let outer: HashSet<[u32; 3]> = old.iter().map(|t| sorted3(opposite(t, q))).collect();
         let mut nbrs: Vec<u32> = old.iter().flatten().copied().filter(|&v| v != q).collect();
@@ -1296,7 +1355,12 @@ impl<'a> Cdt<'a> {
                 continue;
             }
             let (flat, lo) = shape(&self.dt, &new);
-            if flat >= flat0 || best.as_ref().is_some_and(|b| (flat, -lo) >= (b.0, -b.1)) {
+            let worse = if by_angle {
+                flat > flat0 || (flat == flat0 && lo <= lo0)
+            } else {
+                flat >= flat0
+            };
+            if worse || best.as_ref().is_some_and(|b| (flat, -lo) >= (b.0, -b.1)) {
                 continue;
             }
             if self.tiles(&outer, q, &new) {
@@ -1486,7 +1550,7 @@ impl<'a> Cdt<'a> {
             pts,
             tets,
             grown: self.grown,
-            tiny: self.tiny,
+            tiny: self.tiny.iter().filter(|v| map.contains_key(v)).count(),
         })
     }
 }
