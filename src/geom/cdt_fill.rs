@@ -1272,9 +1272,7 @@ impl<'a> Cdt<'a> {
         }
     }
 
-    /// Contract point `q` (off the surface) into the star neighbour that leaves the fewest
-    /// numerically flat tets, fewer than its star has, then the largest smallest dihedral
-    /// angle; false (nothing changed) when none does.
+    /// [`Cdt::contract_point_by`] for fewer numerically flat tets.
     fn contract_point(&mut self, q: u32) -> bool {
         self.contract_point_by(q, false)
     }
@@ -1312,6 +1310,7 @@ impl<'a> Cdt<'a> {
             cand.dedup();
             let mut changed = 0;
             for q in cand {
+                // (A point contracted earlier in the round has no star.)
                 if !self.dt.star(q).is_empty() && self.contract_point_by(q, true) {
                     changed += 1;
                 }
@@ -1322,6 +1321,10 @@ impl<'a> Cdt<'a> {
         }
     }
 
+    /// Contract point `q` (off the surface) into the star neighbour that leaves the fewest
+    /// numerically flat tets, then the largest smallest dihedral angle, where that leaves
+    /// fewer flat tets than its star has or (`by_angle`) no more and a larger smallest
+    /// angle; false (nothing changed) when none does.
     fn contract_point_by(&mut self, q: u32, by_angle: bool) -> bool {
         let star = self.dt.star(q);
         let old: Vec<[u32; 4]> = star.iter().map(|&t| self.dt.tets[t as usize]).collect();
