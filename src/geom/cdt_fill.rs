@@ -506,7 +506,7 @@ impl<'a> Cdt<'a> {
         let mut best = (0.0f64, 0.5);
         for (t, _) in self.dt.crossed_faces(cur, goal) {
             for v in self.dt.tets[t as usize] {
-                if v == cur || v == goal || v == NONE {
+                if v == cur || v == goal {
                     continue;
                 }
                 let p = self.dt.p(v);
@@ -1282,28 +1282,19 @@ impl<'a> Cdt<'a> {
     /// that raises their star's smallest dihedral angle most, without more numerically
     /// flat tets; a few rounds while some point goes.
     fn contract_slivers(&mut self) {
-        let surface: HashSet<u32> = self.faces.iter().flatten().copied().collect();
+        // Steiner points come after the input points and the four enclosing ones; none
+        // is on the surface (every one has been moved off it).
         let first_steiner = self.dt.n as u32 + 4;
         for _ in 0..CONTRACT_ROUNDS {
             let mut cand: Vec<u32> = Vec::new();
             for t in 0..self.dt.tets.len() {
-                if !self.dt.alive[t] {
-                    continue;
-                }
                 let tv = self.dt.tets[t];
-                if tv
-                    .iter()
-                    .all(|&v| v < first_steiner || surface.contains(&v))
-                {
+                if !self.dt.alive[t] || tv.iter().all(|&v| v < first_steiner) {
                     continue;
                 }
                 let c = tv.map(|v| self.dt.p(v));
                 if numerically_flat(&c) || dihedral_extremes(&c).0 < SLIVER_CONTRACT_DEG {
-                    cand.extend(
-                        tv.iter()
-                            .copied()
-                            .filter(|&v| v >= first_steiner && !surface.contains(&v)),
-                    );
+                    cand.extend(tv.iter().copied().filter(|&v| v >= first_steiner));
                 }
             }
             cand.sort_unstable();
