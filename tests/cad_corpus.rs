@@ -255,9 +255,9 @@ corpus_parts! {
     geb_meshes: "GEB", 5_724, 13;
     children_meshes: "children", 8_888, 0;
     children_indexed_meshes: "children_indexed", 6_650, 0;
-    example005_meshes: "example005", 1_042, 20;
+    example005_meshes: "example005", 1_042, 17;
     example006_meshes: "example006", 11_884, 0;
-    example007_meshes: "example007", 524, 1;
+    example007_meshes: "example007", 524, 0;
     example009_meshes: "example009", 1_640, 0;
     example010_meshes: "example010", 9_542, 25;
     example012_meshes: "example012", 916, 4;
@@ -268,7 +268,7 @@ corpus_parts! {
     example023_meshes: "example023", 3_028, 0;
     example024_meshes: "example024", 12_012, 4;
     linear_extrude_meshes: "linear_extrude", 1_690, 0;
-    logo_meshes: "logo", 8_120, 4;
+    logo_meshes: "logo", 8_120, 3;
     logo_and_text_meshes: "logo_and_text", 14_792, 12;
     projection_meshes: "projection", 1_112, 20;
     rotate_extrude_meshes: "rotate_extrude", 9_200, 0;

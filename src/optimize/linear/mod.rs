@@ -25,7 +25,7 @@ use crate::geom::vec3::P3;
 use crate::optimize::Boundary;
 use contract::{contract, ContractScratch};
 use flips::{flip23, remove_edge, FlipScratch};
-use insert::{split_edge, InsertScratch};
+use insert::{insert_in_cavity, split_edge, InsertScratch};
 use mesh::LinMesh;
 pub use objective::ElementQuality;
 use smooth::{search_vertex, smooth_vertex, SmoothParams, SmoothScratch};
@@ -191,6 +191,9 @@ struct Scratch {
     smooth: SmoothScratch,
     smooth_prm: SmoothParams,
     insert: InsertScratch,
+    /// Whether [`improve_tet`] also tries [`insert_in_cavity`] (the sliver passes' last
+    /// rounds).
+    cavities: bool,
 }
 
 /// Improve the straight-sided tets `tets` on `pts` (surface nodes first, as the front
@@ -230,6 +233,7 @@ pub fn improve_linear_known(
         smooth: SmoothScratch::default(),
         smooth_prm: SmoothParams::default(),
         insert: InsertScratch::default(),
+        cavities: false,
     };
     let mut order: Vec<(f64, u32, [u32; 4])> = Vec::new();
     // Clock at which each tet slot last resisted every operation (0: never); it is not
@@ -312,26 +316,41 @@ fn unforced_sliver_passes(
         // before it (OpenSCAD's example010: 25, then 36).
         let mut best = (left, m.clone());
         let mut passes = 0;
-        while left > 0 && passes < prm.sliver_passes {
-            let round = LinearParams {
-                max_passes: SLIVER_ROUND_PASSES.min(prm.sliver_passes - passes),
-                ..p.clone()
-            };
-            let before = st.passes;
-            run_passes(m, &round, sc, st, order, &mut failed);
-            passes += (st.passes - before).max(1);
-            if census(m, 1.0).1 > 0 {
-                search_worst(m, &p, sc, st, order);
+        // Once the rounds stop removing any, more rounds from the best mesh so far with
+        // cavity insertions as a last resort: only then, so that the rounds before take
+        // the same path as without them (they make some parts end with more).
+        loop {
+            while left > 0 && passes < prm.sliver_passes {
+                let round = LinearParams {
+                    max_passes: SLIVER_ROUND_PASSES.min(prm.sliver_passes - passes),
+                    ..p.clone()
+                };
+                let before = st.passes;
+                run_passes(m, &round, sc, st, order, &mut failed);
+                passes += (st.passes - before).max(1);
+                if census(m, 1.0).1 > 0 {
+                    search_worst(m, &p, sc, st, order);
+                }
+                let now = census(m, 1.0).1;
+                if now < best.0 {
+                    best = (now, m.clone());
+                }
+                if now >= left {
+                    break;
+                }
+                left = now;
             }
-            let now = census(m, 1.0).1;
-            if now < best.0 {
-                best = (now, m.clone());
-            }
-            if now >= left {
+            if sc.cavities || best.0 == 0 || passes >= prm.sliver_passes {
                 break;
             }
-            left = now;
+            if census(m, 1.0).1 > best.0 {
+                *m = best.1.clone();
+            }
+            sc.cavities = true;
+            failed.clear();
+            left = best.0;
         }
+        sc.cavities = false;
         if census(m, 1.0).1 > best.0 {
             *m = best.1;
         }
@@ -525,6 +544,10 @@ fn improve_tet(m: &mut LinMesh, t: u32, eps: f64, sc: &mut Scratch, st: &mut Lin
             st.insertions += 1;
             return true;
         }
+    }
+    if sc.cavities && insert_in_cavity(m, tv, eps, &sc.smooth_prm, &mut sc.insert, &mut sc.smooth) {
+        st.insertions += 1;
+        return true;
     }
     moved
 }
