@@ -22,8 +22,8 @@ use super::size::SizeField;
 use super::{FillTry, FrontOutput, FrontStats};
 use crate::geom::cdt_fill::{self, Patience, Split};
 use crate::geom::distance::point_triangle_dist2;
-use crate::geom::vec3::{axpy, cross, dist2, dot, mid, scale, sub, P3};
-use std::collections::HashSet;
+use crate::geom::vec3::{axpy, cross, dist, dist2, dot, mid, scale, sub, P3};
+use rustc_hash::FxHashSet as HashSet;
 
 /// Largest leaf side, as a multiple of the size at its centre. The lattice's edges are
 /// the side and 0.87 of it, and leaves are between half and all of this.
@@ -223,42 +223,64 @@ fn interior_points(
     mean_edge /= surf_tris.len().max(1) as f64;
     let mut grid = FaceGrid::new(bounds, 2.0 * mean_edge, (16 * surf_tris.len()).max(1 << 16));
     let balls: Vec<Vec<(P3, f64)>> = tris.iter().map(|&t| protecting_balls(t)).collect();
-    for (i, t) in tris.iter().enumerate() {
-        let mut b = Aabb::of(t);
-        for &(c, r2) in &balls[i] {
-            let r = r2.sqrt();
-            b.lo = std::array::from_fn(|d| b.lo[d].min(c[d] - r));
-            b.hi = std::array::from_fn(|d| b.hi[d].max(c[d] + r));
-        }
-        grid.insert(i as u32, &b);
+    // Each triangle's box with its balls: what the grid files it under, and the filter
+    // of what a cell's list gives (a needle's balls span many cells).
+    let boxes: Vec<Aabb> = tris
+        .iter()
+        .zip(&balls)
+        .map(|(t, balls)| {
+            let mut b = Aabb::of(t);
+            for &(c, r2) in balls {
+                let r = r2.sqrt();
+                b.lo = std::array::from_fn(|d| b.lo[d].min(c[d] - r));
+                b.hi = std::array::from_fn(|d| b.hi[d].max(c[d] + r));
+            }
+            b
+        })
+        .collect();
+    for (i, b) in boxes.iter().enumerate() {
+        grid.insert(i as u32, b);
     }
     // Integer coordinates in units of the root side / 2^(MAX_DEPTH + 1): every leaf's
     // corners and centre are whole, so shared points are found exactly.
     let unit = ext / f64::from(1u32 << (MAX_DEPTH + 1));
     let at = |c: [u64; 3]| -> P3 { [0, 1, 2].map(|d| bounds.lo[d] + c[d] as f64 * unit) };
-    let mut seen: HashSet<[u64; 3]> = HashSet::new();
-    let mut cand: Vec<P3> = Vec::new();
-    // (min corner, depth); children pushed in reverse Morton order, so popped in order.
-    let mut stack: Vec<([u64; 3], u32)> = vec![([0; 3], 0)];
-    while let Some((lo, depth)) = stack.pop() {
+    let mut seen: HashSet<[u64; 3]> = HashSet::default();
+    // Each candidate with what is known of the size there: the size itself (a leaf's
+    // centre, measured to split or keep the leaf), or a lower bound of the distance to
+    // the nearest surface vertex, from which the size field may answer without a
+    // search (the same value, bit for bit: [`SizeField::at_near`]).
+    let mut cand: Vec<(P3, Result<f64, f64>)> = Vec::new();
+    // A lower bound of the distance from `q` to the nearest surface vertex, given one,
+    // `bound`, at `p` (the triangle inequality, with a margin for rounding).
+    let less =
+        |bound: f64, p: P3, q: P3| ((bound - dist(p, q) * (1.0 + 1e-12)) * (1.0 - 1e-9)).max(0.0);
+    // (min corner, depth, distance floor at the centre); children pushed in reverse
+    // Morton order, so popped in order.
+    let mut stack: Vec<([u64; 3], u32, f64)> = vec![([0; 3], 0, 0.0)];
+    while let Some((lo, depth, floor)) = stack.pop() {
         let half = 1u64 << (MAX_DEPTH - depth);
         let side = ext / f64::from(1u32 << depth);
         let centre = lo.map(|c| c + half);
-        if side > LEAF_PER_SIZE * size.at(at(centre)) && depth < MAX_DEPTH {
+        let (h, bound) = size.at_near(at(centre), floor);
+        if side > LEAF_PER_SIZE * h && depth < MAX_DEPTH {
             for k in (0..8u64).rev() {
                 let child = [0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * half);
-                stack.push((child, depth + 1));
+                let child_centre = child.map(|c| c + half / 2);
+                let child_floor = less(bound, at(centre), at(child_centre));
+                stack.push((child, depth + 1, child_floor));
             }
             continue;
         }
-        let mut emit = |c: [u64; 3]| {
+        let mut emit = |c: [u64; 3], known: Result<f64, f64>| {
             if seen.insert(c) {
-                cand.push(at(c));
+                cand.push((at(c), known));
             }
         };
-        emit(centre);
+        emit(centre, Ok(h));
         for k in 0..8u64 {
-            emit([0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * 2 * half));
+            let corner = [0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * 2 * half);
+            emit(corner, Err(less(bound, at(centre), at(corner))));
         }
         if cand.len() > MAX_POINTS {
             return Err(format!(
@@ -268,13 +290,16 @@ fn interior_points(
     }
     let mut near = Vec::new();
     let mut keep = Vec::with_capacity(cand.len());
-    for p in cand {
-        let r = CLEARANCE * size.at(p);
+    for (p, known) in cand {
+        let h = known.unwrap_or_else(|floor| size.at_near(p, floor).0);
+        let r = CLEARANCE * h;
         let b = Aabb {
             lo: p.map(|x| x - r),
             hi: p.map(|x| x + r),
         };
         grid.query(&b, |_| true, &mut near);
+        // (A triangle whose box misses `b` is farther than r, and so are its balls.)
+        near.retain(|&i| boxes[i as usize].overlaps(&b));
         let clear = near.iter().all(|&i| {
             let q = tris[i as usize];
             point_triangle_dist2(p, q[0], q[1], q[2]) >= r * r
