@@ -264,7 +264,7 @@ corpus_parts! {
     example018_meshes: "example018", 4_960, 0;
     example019_meshes: "example019", 3_912, 3;
     example020_meshes: "example020", 8_490, 433;
-    example021_meshes: "example021", 1_280, 13;
+    example021_meshes: "example021", 1_280, 12;
     example023_meshes: "example023", 3_028, 0;
     example024_meshes: "example024", 12_012, 4;
     linear_extrude_meshes: "linear_extrude", 1_690, 0;

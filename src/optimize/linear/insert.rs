@@ -136,7 +136,7 @@ pub(super) fn split_edge(
 }
 
 /// Rings of face neighbours around the tet of [`insert_in_cavity`] in its cavity (OpenSCAD
-/// corpus, unforced slivers: 627 without cavities, 623 with one ring, 622 with two).
+/// corpus, unforced slivers: 627 without cavities, 622 with one ring, 621 with two).
 const CAVITY_RINGS: usize = 2;
 
 /// Try inserting a new interior vertex into the cavity of the tet on `tv` and its

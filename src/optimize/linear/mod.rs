@@ -284,7 +284,8 @@ pub fn improve_linear_known(
 /// The passes and searches of [`LinearParams::sliver_passes`]: the element quality
 /// gives way to [`LinMesh::sliver_score`], below 1 on the unforced slivers only, and the
 /// passes and searches aim at those (every tet below 1), with a budget of two attempts
-/// per tet of the input on top of what was spent.
+/// per tet of the input on top of what was spent. Where the rounds stall, the last ones
+/// also try [`insert_in_cavity`].
 fn unforced_sliver_passes(
     m: &mut LinMesh,
     prm: &LinearParams,
