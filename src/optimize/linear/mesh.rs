@@ -2,7 +2,6 @@
 //! operations of the linear stage edit.
 
 use super::objective::ElementQuality;
-use crate::geom::tet_quality::dihedral_extremes;
 use crate::geom::vec3::P3;
 use crate::optimize::Boundary;
 
@@ -147,15 +146,15 @@ impl<'a> LinMesh<'a> {
     /// one beside them. The boundary edges in [`LinMesh::chorded`] are taken straight.
     /// When the score is ≤ `floor` the value may be any such one.
     pub fn sliver_score(&self, v: [u32; 4], c: &[P3; 4], floor: f64) -> f64 {
-        let q = self
-            .eq
-            .eval_above_with(self.bnd, &self.pts, v, c, floor.min(0.0), |e| {
-                self.chorded.contains(&e)
-            });
+        let (q, lo) =
+            self.eq
+                .eval_and_min_dihedral(self.bnd, &self.pts, v, c, floor.min(0.0), |e| {
+                    self.chorded.contains(&e)
+                });
         if q <= 0.0 {
             return q;
         }
-        (dihedral_extremes(c).0 / self.bnd.tet_sliver_floor(v)).min(1.0)
+        (lo / self.bnd.tet_sliver_floor(v)).min(1.0)
     }
 
     /// Score tets by [`LinMesh::sliver_score`] (`on`) or by the element quality from now

@@ -71,66 +71,87 @@ impl ElementQuality {
         floor: f64,
         on_chord: impl Fn((u32, u32)) -> bool,
     ) -> f64 {
+        self.eval_and_min_dihedral(bnd, pts, v, c, floor, on_chord)
+            .0
+    }
+
+    /// [`ElementQuality::eval_above_with`] and the tet's smallest dihedral angle
+    /// (degrees; NaN where the quality is −∞ without it), measured once for both (the
+    /// sliver passes' score needs both).
+    #[inline]
+    pub(crate) fn eval_and_min_dihedral(
+        &self,
+        bnd: &Boundary,
+        pts: &[P3],
+        v: [u32; 4],
+        c: &[P3; 4],
+        floor: f64,
+        on_chord: impl Fn((u32, u32)) -> bool,
+    ) -> (f64, f64) {
         // A numerically flat tet scores as an inverted one: its Jacobian cannot be
         // certified, so the stage never makes one and works to remove those it is given.
         if orient3d(c[0], c[1], c[2], c[3]) <= 0 || numerically_flat(c) {
-            return f64::NEG_INFINITY;
+            return (f64::NEG_INFINITY, f64::NAN);
         }
         let (lo, hi) = dihedral_extremes(c);
-        let s = skewness_from_extremes(lo, hi);
-        if !s.is_finite() {
-            return f64::NEG_INFINITY;
-        }
-        if 1.0 - s <= floor {
-            return 1.0 - s;
-        }
-        let nb = v.iter().filter(|&&x| bnd.is_fixed(x)).count();
-        if nb >= 2 {
-            let (x, curved) = bnd.tet10_with(pts, v, c, on_chord);
-            if !curved {
+        // (The shape's score, with early returns.)
+        let q = (|| {
+            let s = skewness_from_extremes(lo, hi);
+            if !s.is_finite() {
+                return f64::NEG_INFINITY;
+            }
+            if 1.0 - s <= floor {
                 return 1.0 - s;
             }
-            // The Bernstein coefficients settle almost every tet at once (certify would
-            // compute the same ones first); only the undecided go through `certify`.
-            let lj = LinearJacobian::new(&x);
-            let b = lj.bezier();
-            let (blo, bhi) = b
-                .iter()
-                .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
-            let tau = lj.rounding_margin();
-            let valid = (blo > tau && blo.is_finite()) || certify(&x).is_valid();
-            // Edges the high-order stage may curve (not boundary edges).
-            let free_mid = || TET10_EDGES.map(|[i, j]| bnd.edge_mid(v[i], v[j]).is_none());
-            if !valid {
-                // Invalid whatever the high-order stage does with the interior mid
-                // nodes (a coefficient only boundary nodes set is not positive): as bad
-                // as an inverted tet, so no operation creates one.
-                if !fixed_coefficients_positive(&b, tau, free_mid()) {
-                    return f64::NEG_INFINITY;
+            let nb = v.iter().filter(|&&x| bnd.is_fixed(x)).count();
+            if nb >= 2 {
+                let (x, curved) = bnd.tet10_with(pts, v, c, on_chord);
+                if !curved {
+                    return 1.0 - s;
                 }
-                // How far det J is from positive, in (-1, 0]: min_lower over |min_lower| +
-                // |max_upper|, which keeps falling as the element gets more inverted (the
-                // scaled Jacobian's bound is -1 for every fully inverted element, a
-                // plateau on which no operation could show progress: on OpenSCAD's
-                // example021 the whole fill left such tets that the passes never moved).
-                let jb = jacobian_bounds(&x, 1e-2);
-                let r = jb.min_lower / (jb.min_lower.abs() + jb.max_upper.abs());
-                let r = if r.is_nan() { -1.0 } else { r.clamp(-1.0, 0.0) };
-                return -1.0 + 0.5 * (1.0 + r);
+                // The Bernstein coefficients settle almost every tet at once (certify would
+                // compute the same ones first); only the undecided go through `certify`.
+                let lj = LinearJacobian::new(&x);
+                let b = lj.bezier();
+                let (blo, bhi) = b
+                    .iter()
+                    .fold((f64::INFINITY, 0.0f64), |(l, h), &v| (l.min(v), h.max(v)));
+                let tau = lj.rounding_margin();
+                let valid = (blo > tau && blo.is_finite()) || certify(&x).is_valid();
+                // Edges the high-order stage may curve (not boundary edges).
+                let free_mid = || TET10_EDGES.map(|[i, j]| bnd.edge_mid(v[i], v[j]).is_none());
+                if !valid {
+                    // Invalid whatever the high-order stage does with the interior mid
+                    // nodes (a coefficient only boundary nodes set is not positive): as bad
+                    // as an inverted tet, so no operation creates one.
+                    if !fixed_coefficients_positive(&b, tau, free_mid()) {
+                        return f64::NEG_INFINITY;
+                    }
+                    // How far det J is from positive, in (-1, 0]: min_lower over |min_lower| +
+                    // |max_upper|, which keeps falling as the element gets more inverted (the
+                    // scaled Jacobian's bound is -1 for every fully inverted element, a
+                    // plateau on which no operation could show progress: on OpenSCAD's
+                    // example021 the whole fill left such tets that the passes never moved).
+                    let jb = jacobian_bounds(&x, 1e-2);
+                    let r = jb.min_lower / (jb.min_lower.abs() + jb.max_upper.abs());
+                    let r = if r.is_nan() { -1.0 } else { r.clamp(-1.0, 0.0) };
+                    return -1.0 + 0.5 * (1.0 + r);
+                }
+                let ratio = blo / bhi;
+                if nb == 4 {
+                    // No interior vertex: the high-order stage can move few nodes of this
+                    // tet, so its curved shape counts here (unrefined Bernstein ratio).
+                    let free = free_mid().iter().filter(|&&f| f).count();
+                    let k = if free <= 1 { PINNED_CURVED_WEIGHT } else { 1.0 };
+                    return (1.0 - s).min(k * ratio);
+                }
+                // A curved tet barely valid with straight interior edges blocks every move
+                // of its corners: count it as bad, so it is worked on first.
+                return (1.0 - s).min(CURVED_WEIGHT * ratio);
             }
-            let ratio = blo / bhi;
-            if nb == 4 {
-                // No interior vertex: the high-order stage can move few nodes of this
-                // tet, so its curved shape counts here (unrefined Bernstein ratio).
-                let free = free_mid().iter().filter(|&&f| f).count();
-                let k = if free <= 1 { PINNED_CURVED_WEIGHT } else { 1.0 };
-                return (1.0 - s).min(k * ratio);
-            }
-            // A curved tet barely valid with straight interior edges blocks every move
-            // of its corners: count it as bad, so it is worked on first.
-            return (1.0 - s).min(CURVED_WEIGHT * ratio);
-        }
-        1.0 - s
+            1.0 - s
+        })();
+        (q, lo)
     }
 }
 
