@@ -342,6 +342,12 @@ impl Delaunay {
     /// units of roundoff times the magnitude times its longest edge squared.
     /// [`SOLID_MARGIN`] is a million times that.
     fn clearly_solid(&self, t: [u32; 4]) -> bool {
+        self.clearly_thick(t, false)
+    }
+
+    /// [`Delaunay::clearly_solid`], for a tet of either orientation with `either`: its
+    /// 6 x volume that far from 0 on either side, so not flat by construction either.
+    fn clearly_thick(&self, t: [u32; 4], either: bool) -> bool {
         let p = t.map(|v| self.p(v));
         let l2 = (0..4)
             .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
@@ -349,6 +355,7 @@ impl Delaunay {
             .fold(0.0, f64::max);
         // A face's area is at least 6V / (2 x its opposite height) >= 6V / (2 sqrt(l2)).
         let det = super::vec3::tet_det(p[0], p[1], p[2], p[3]);
+        let det = if either { det.abs() } else { det };
         det > 2.0 * SOLID_MARGIN * self.magnitude.max(l2.sqrt()) * l2
     }
 
@@ -716,7 +723,8 @@ impl Delaunay {
         };
         let on_face = |dt: &Delaunay, t: u32, j: usize| {
             let n = new_tet(dt, t, j);
-            orient3d(dt.p(n[0]), dt.p(n[1]), dt.p(n[2]), p) == 0 || dt.flat_by_construction(n)
+            orient3d(dt.p(n[0]), dt.p(n[1]), dt.p(n[2]), p) == 0
+                || (!dt.clearly_thick(n, true) && dt.flat_by_construction(n))
         };
         let holds = |dt: &Delaunay, t: u32| {
             (0..4).all(|j| dt.positive(new_tet(dt, t, j)) || on_face(dt, t, j))
