@@ -124,15 +124,20 @@ pub(super) fn split_edge(
     {
         return true;
     }
-    // Undo: the new vertex stays as an unused point.
-    for i in 0..s.added.len() {
-        m.remove(s.added[i]);
-    }
-    // (Their corners are where they were: the new vertex is in none of them.)
-    for i in 0..s.old.len() {
-        m.add(s.old[i], s.old_q[i]);
-    }
+    undo(m, s);
     false
+}
+
+/// Put back the tets `s.old` (qualities `s.old_q`) in place of the tets `s.added`: an
+/// insertion not kept. The new vertex stays as an unused point; the old tets' corners are
+/// where they were (the new vertex is in none of them).
+fn undo(m: &mut LinMesh, s: &InsertScratch) {
+    for &t in &s.added {
+        m.remove(t);
+    }
+    for (&t, &q) in s.old.iter().zip(&s.old_q) {
+        m.add(t, q);
+    }
 }
 
 /// Rings of face neighbours around the tet of [`insert_in_cavity`] in its cavity (OpenSCAD
@@ -258,13 +263,7 @@ pub(super) fn insert_in_cavity(
     if new_min > old_min + eps && !m.more_unforced(s.old_q.iter().copied(), new_q) {
         return true;
     }
-    // Undo: the new vertex stays as an unused point.
-    for i in 0..s.added.len() {
-        m.remove(s.added[i]);
-    }
-    for i in 0..s.old.len() {
-        m.add(s.old[i], s.old_q[i]);
-    }
+    undo(m, s);
     false
 }
 
