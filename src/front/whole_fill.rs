@@ -262,12 +262,13 @@ fn interior_points(
         let half = 1u64 << (MAX_DEPTH - depth);
         let side = ext / f64::from(1u32 << depth);
         let centre = lo.map(|c| c + half);
-        let (h, bound) = size.at_near(at(centre), floor);
+        let pc = at(centre);
+        let (h, bound) = size.at_near(pc, floor);
         if side > LEAF_PER_SIZE * h && depth < MAX_DEPTH {
             for k in (0..8u64).rev() {
                 let child = [0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * half);
                 let child_centre = child.map(|c| c + half / 2);
-                let child_floor = less(bound, at(centre), at(child_centre));
+                let child_floor = less(bound, pc, at(child_centre));
                 stack.push((child, depth + 1, child_floor));
             }
             continue;
@@ -280,7 +281,7 @@ fn interior_points(
         emit(centre, Ok(h));
         for k in 0..8u64 {
             let corner = [0, 1, 2].map(|d| lo[d] + ((k >> d) & 1) * 2 * half);
-            emit(corner, Err(less(bound, at(centre), at(corner))));
+            emit(corner, Err(less(bound, pc, at(corner))));
         }
         if cand.len() > MAX_POINTS {
             return Err(format!(

@@ -342,12 +342,19 @@ impl Delaunay {
     /// units of roundoff times the magnitude times its longest edge squared.
     /// [`SOLID_MARGIN`] is a million times that.
     fn clearly_solid(&self, t: [u32; 4]) -> bool {
-        self.clearly_thick(t, false)
+        let (det, margin) = self.det_and_margin(t);
+        det > margin
     }
 
-    /// [`Delaunay::clearly_solid`], for a tet of either orientation with `either`: its
-    /// 6 x volume that far from 0 on either side, so not flat by construction either.
-    fn clearly_thick(&self, t: [u32; 4], either: bool) -> bool {
+    /// [`Delaunay::clearly_solid`] for a tet of either orientation: 6 x volume that far
+    /// from 0 on either side, so not flat by construction either.
+    fn clearly_thick(&self, t: [u32; 4]) -> bool {
+        let (det, margin) = self.det_and_margin(t);
+        det.abs() > margin
+    }
+
+    /// Tet `t`'s 6 x signed volume and the least [`Delaunay::clearly_solid`] asks of it.
+    fn det_and_margin(&self, t: [u32; 4]) -> (f64, f64) {
         let p = t.map(|v| self.p(v));
         let l2 = (0..4)
             .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
@@ -355,8 +362,7 @@ impl Delaunay {
             .fold(0.0, f64::max);
         // A face's area is at least 6V / (2 x its opposite height) >= 6V / (2 sqrt(l2)).
         let det = super::vec3::tet_det(p[0], p[1], p[2], p[3]);
-        let det = if either { det.abs() } else { det };
-        det > 2.0 * SOLID_MARGIN * self.magnitude.max(l2.sqrt()) * l2
+        (det, 2.0 * SOLID_MARGIN * self.magnitude.max(l2.sqrt()) * l2)
     }
 
     /// The input points an added point stands for (itself for an input point), for
@@ -724,7 +730,7 @@ impl Delaunay {
         let on_face = |dt: &Delaunay, t: u32, j: usize| {
             let n = new_tet(dt, t, j);
             orient3d(dt.p(n[0]), dt.p(n[1]), dt.p(n[2]), p) == 0
-                || (!dt.clearly_thick(n, true) && dt.flat_by_construction(n))
+                || (!dt.clearly_thick(n) && dt.flat_by_construction(n))
         };
         let holds = |dt: &Delaunay, t: u32| {
             (0..4).all(|j| dt.positive(new_tet(dt, t, j)) || on_face(dt, t, j))

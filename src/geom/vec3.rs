@@ -100,6 +100,13 @@ pub fn tri_normal(a: P3, b: P3, c: P3) -> P3 {
 pub fn tri_area(a: P3, b: P3, c: P3) -> f64 {
     0.5 * norm(tri_normal(a, b, c))
 }
+/// Centroid of a tet.
+#[inline]
+pub fn centroid4(c: &[P3; 4]) -> P3 {
+    let [a, b, d, e] = *c;
+    std::array::from_fn(|k| 0.25 * (a[k] + b[k] + d[k] + e[k]))
+}
+
 /// Centroid of a triangle.
 #[inline]
 pub fn centroid3(a: P3, b: P3, c: P3) -> P3 {

@@ -16,16 +16,8 @@ pub(crate) fn enclosed(tris: &[[P3; 3]], pts: &[P3]) -> Vec<bool> {
     pts.iter()
         .map(|&p| {
             grid.ray_x(&boxes, p, &mut cand);
-            // (The grid's row gives every triangle the ray may meet and many it cannot:
-            // those whose closed box misses the ray go before the exact test.)
             let crossed = cand
                 .iter()
-                .filter(|&&t| {
-                    let [lo, hi] = boxes[t as usize];
-                    hi[0] >= p[0]
-                        && (lo[1]..=hi[1]).contains(&p[1])
-                        && (lo[2]..=hi[2]).contains(&p[2])
-                })
                 .filter(|&&t| {
                     let [a, b, c] = tris[t as usize];
                     ray_crosses(p, a, b, c)

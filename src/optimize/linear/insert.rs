@@ -8,7 +8,7 @@
 use super::mesh::{face_opposite, opposite_edge, LinMesh};
 use super::objective::{cut_bound, ruled_out};
 use super::smooth::{search_vertex, smooth_vertex, SmoothParams, SmoothScratch};
-use crate::geom::vec3::{mid, P3};
+use crate::geom::vec3::{centroid4, mid, P3};
 use crate::mesh::slivers::is_sliver;
 
 /// Scratch buffers of the insertion.
@@ -216,7 +216,7 @@ pub(super) fn insert_in_cavity(
     let np = m.pts.len() as u32;
     let mut start: Option<(f64, P3)> = None;
     for x in &s.old {
-        let p = centroid(&m.corners(*x));
+        let p = centroid4(&m.corners(*x));
         let mut lo = f64::INFINITY;
         for f in &s.faces {
             let c = [
@@ -267,12 +267,6 @@ pub(super) fn insert_in_cavity(
     false
 }
 
-/// The centroid of the four corners `c`.
-fn centroid(c: &[P3; 4]) -> P3 {
-    let [a, b, d, e] = *c;
-    std::array::from_fn(|k| 0.25 * (a[k] + b[k] + d[k] + e[k]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -294,7 +288,7 @@ mod tests {
             [0.0, -1.0, s],
         ];
         // Just inside the face (0, 1, 2), near its centroid.
-        let c: P3 = std::array::from_fn(|k| (pts[0][k] + pts[1][k] + pts[2][k]) / 3.0);
+        let c = crate::geom::vec3::centroid3(pts[0], pts[1], pts[2]);
         let inward: P3 = std::array::from_fn(|k| pts[3][k] - c[k]);
         pts.push(std::array::from_fn(|k| c[k] + 1e-3 * inward[k]));
         let outer = [0u32, 1, 2, 3];
