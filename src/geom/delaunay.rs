@@ -159,8 +159,26 @@ impl Delaunay {
         if !self.alive[t as usize] {
             t = self.alive.iter().position(|&a| a).unwrap_or(0) as u32;
         }
-        // Bounded for safety; a walk in a Delaunay triangulation terminates.
-        for _ in 0..4 * self.tets.len() + 16 {
+        // Bounded for safety; a walk in a Delaunay triangulation terminates, but one in a
+        // triangulation flips and insertions have made non-Delaunay can cycle.
+        let bound = 4 * self.tets.len() + 16;
+        // Past WALK_WATCH steps, each tet visited with its step: the next tet depends
+        // only on the current one, so a walk back at a tet cycles until the bound.
+        // The scan below then starts at once (the whole fill's lifts on OpenSCAD's
+        // example020 walked 69 million steps, 30 cycles), and where it finds nothing,
+        // the answer is the tet the walk would have been at by the bound.
+        let mut seen: HashMap<u32, usize> = HashMap::default();
+        let mut path: Vec<u32> = Vec::new();
+        for step in 0..bound {
+            if step >= WALK_WATCH {
+                if let Some(&j) = seen.get(&t) {
+                    // Steps j.. repeat with period step - j; path holds WALK_WATCH...
+                    t = path[j + (bound - j) % (step - j) - WALK_WATCH];
+                    break;
+                }
+                seen.insert(t, step);
+                path.push(t);
+            }
             let tv = self.tets[t as usize];
             let mut moved = false;
             for (k, f) in FACES.iter().enumerate() {
@@ -179,7 +197,7 @@ impl Delaunay {
                 return t;
             }
         }
-        // Fall back to a scan (never expected).
+        // A cycling walk: a scan.
         (0..self.tets.len() as u32)
             .find(|&t| {
                 self.alive[t as usize] && {
@@ -255,6 +273,10 @@ pub(crate) fn sorted2(a: u32, b: u32) -> [u32; 2] {
         [b, a]
     }
 }
+
+/// Steps a point location walk takes before it watches for a cycle
+/// ([`Delaunay::locate_from`]); walks are a few dozen steps.
+const WALK_WATCH: usize = 64;
 
 pub(crate) fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
     f.sort_unstable();
