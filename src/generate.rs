@@ -222,8 +222,9 @@ fn generate_inner(
         let t = Instant::now();
         let (conf, bad) = pool.install(|| (check::check_conformity(&mesh), uncertified(&mesh)));
         times.certify += t.elapsed().as_secs_f64();
+        // A whole fill has no front configuration after it.
         let next = front.stats.restarts as usize + 1;
-        if conf.is_ok() && !bad.is_empty() && next < RESTARTS.len() {
+        if conf.is_ok() && !bad.is_empty() && !front.stats.whole_fill && next < RESTARTS.len() {
             if progress(0.0, "front (restart: elements left invalid)") {
                 return Err(Error::Cancelled);
             }

@@ -156,6 +156,9 @@ fn cad_exports_that_mesh_keep_meshing_exactly() {
 fn a_cad_part_meshes_with_its_uncertifiable_edges_straightened() {
     let (s, g) = read_and_mesh("example004", 880);
     assert_eq!(g.report.num_invalid, 0);
+    // Its needles send it to the whole fill before any front attempt: no restart.
+    assert!(g.front.whole_fill && g.front.fill_first, "{:?}", g.front);
+    assert_eq!(g.front.restarts, 0, "{:?}", g.front);
     assert!(g.optimize.chords > 0, "{:?}", g.optimize);
     check_mesh_with_chords(&s, &g.mesh, true);
     // The sliver passes took those edges as chords already and lifted the tets'

@@ -67,7 +67,9 @@ pub struct FrontStats {
     /// a free mid node), left for the high-order optimizer to untangle.
     pub p2_invalid: u64,
     /// Whole-front restarts (see [`RESTARTS`]): the front could not be closed, or the
-    /// optimizer left an element of the previous attempt invalid.
+    /// optimizer left an element of the previous attempt invalid. With a whole fill,
+    /// the front attempts that ran before it less one (0 where none ran:
+    /// [`FrontStats::fill_first`], or a front that stalled on its first attempt).
     pub restarts: u32,
     /// Search radius factor of the run that succeeded.
     pub alpha: f64,
@@ -1356,7 +1358,7 @@ pub fn run_front(
     // The whole fill's error, once it has been tried.
     let mut fill_failed: Option<String> = None;
     if first == 0 && fill_first(surf_nodes, surf_tris) {
-        match whole_fill_stage(surf_nodes, surf_tris, opts, size, progress)? {
+        match whole_fill_stage(surf_nodes, surf_tris, opts, size, 0, progress)? {
             Ok(mut out) => {
                 out.stats.fill_first = true;
                 return Ok(out);
@@ -1405,7 +1407,14 @@ pub fn run_front(
                 // A stalled front hands the region to the whole fill at once (tried once;
                 // where it fails, the next configuration runs).
                 if m.stalled && fill_failed.is_none() {
-                    match whole_fill_stage(surf_nodes, surf_tris, opts, size, progress)? {
+                    match whole_fill_stage(
+                        surf_nodes,
+                        surf_tris,
+                        opts,
+                        size,
+                        attempt + 1,
+                        progress,
+                    )? {
                         Ok(out) => return Ok(out),
                         Err(why) => fill_failed = Some(why),
                     }
@@ -1420,7 +1429,7 @@ pub fn run_front(
     // Every attempt failed: the whole region at once, boundary kept.
     let why = match fill_failed {
         Some(why) => why,
-        None => match whole_fill_stage(surf_nodes, surf_tris, opts, size, progress)? {
+        None => match whole_fill_stage(surf_nodes, surf_tris, opts, size, attempts, progress)? {
             Ok(out) => return Ok(out),
             Err(why) => why,
         },
@@ -1435,13 +1444,15 @@ pub fn run_front(
     })
 }
 
-/// The whole fill of the region ([`whole_fill`]), reported as the last front
-/// configuration (so that no restart follows it). The inner Err says why it failed.
+/// The whole fill of the region ([`whole_fill`]), after `attempts_run` front attempts
+/// (counted from the first configuration, those a caller skipped included). The inner
+/// Err says why it failed.
 fn whole_fill_stage(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
     opts: &Options,
     size: &SizeField,
+    attempts_run: usize,
     progress: Progress,
 ) -> Result<std::result::Result<FrontOutput, String>> {
     if progress(0.0, "whole fill") {
@@ -1449,7 +1460,7 @@ fn whole_fill_stage(
     }
     Ok(
         whole_fill::whole_fill(surf_nodes, surf_tris, size).map(|mut out| {
-            out.stats.restarts = (RESTARTS.len() - 1) as u32;
+            out.stats.restarts = attempts_run.saturating_sub(1) as u32;
             out.stats.alpha = opts.alpha;
             out.stats.size_scale = 1.0;
             out
@@ -1498,7 +1509,8 @@ mod tests {
         FRONT_OFF.with(|c| c.set(false));
         let g = g.expect("the whole fill meshes the sphere");
         assert!(g.front.whole_fill, "{:?}", g.front);
-        assert_eq!(g.front.restarts as usize, RESTARTS.len() - 1);
+        // No front attempt ran: no restart.
+        assert_eq!(g.front.restarts, 0);
         let q = &g.report.quality;
         assert_eq!(g.report.num_invalid, 0);
         assert!(
