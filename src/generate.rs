@@ -150,7 +150,10 @@ fn generate_inner(
     // choice the greedy front makes, as for a front that cannot close). Bounded by
     // RESTARTS; the last attempt's result stands, whatever it is.
     let mut first = 0;
-    let (front_stats, mesh, ostats, conf, bad) = loop {
+    // Seconds of the passes whose mesh a restart dropped.
+    let mut dropped = 0.0;
+    let (mut front_stats, mesh, ostats, conf, bad) = loop {
+        let pass = Instant::now();
         let t = Instant::now();
         let front = run_front(
             surface.nodes(),
@@ -229,6 +232,7 @@ fn generate_inner(
                 return Err(Error::Cancelled);
             }
             first = next;
+            dropped += pass.elapsed().as_secs_f64();
             continue;
         }
         let (mut mesh, mut conf, mut bad) = (mesh, conf, bad);
@@ -256,6 +260,7 @@ fn generate_inner(
         }
         break (front.stats, mesh, ostats, conf, bad);
     };
+    front_stats.discarded_seconds += dropped;
     let conf = match conf {
         Ok(c) => c,
         Err(Error::InvalidMesh { elements, msg, .. }) => {

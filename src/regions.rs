@@ -736,6 +736,7 @@ fn add_front(a: &mut FrontStats, b: &FrontStats) {
         .extend(b.whole_fill_tries.iter().cloned());
     a.p2_invalid += b.p2_invalid;
     a.restarts += b.restarts;
+    a.discarded_seconds += b.discarded_seconds;
     a.alpha = b.alpha;
     a.size_scale = b.size_scale;
 }

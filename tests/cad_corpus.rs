@@ -115,6 +115,14 @@ fn corpus_part_meshes(name: &str, ntri: usize, chords: bool, unforced_at_most: u
     let (s, g) = read_and_mesh(name, ntri);
     assert_eq!(g.report.num_invalid, 0, "{name}");
     check_mesh_with_chords(&s, &g.mesh, chords);
+    // The report says what front work was thrown away: none where the whole fill ran
+    // first, some where a front attempt ran before it.
+    let f = &g.front;
+    if f.fill_first {
+        assert_eq!((f.restarts, f.discarded_seconds), (0, 0.0), "{name}: {f:?}");
+    } else if f.whole_fill {
+        assert!(f.discarded_seconds > 0.0, "{name}: {f:?}");
+    }
     assert!(
         g.report.slivers.unforced <= unforced_at_most,
         "{name}: {:?}",

@@ -85,6 +85,11 @@ pub struct FrontStats {
     /// [`FILL_FIRST_POOR_FRACTION`] of the surface's triangles are poorly shaped, or one
     /// has an aspect ratio above [`FILL_FIRST_WORST_ASPECT_RATIO`].
     pub fill_first: bool,
+    /// Seconds spent in front attempts whose tets were dropped: attempts that did not
+    /// close, before the one that did or before the whole fill, and attempts whose mesh
+    /// the optimizer left with elements it could not certify (then the next
+    /// configuration ran).
+    pub discarded_seconds: f64,
 }
 
 /// One try of the whole fill (`whole_fill`): how it placed Steiner points, with which
@@ -1366,8 +1371,9 @@ pub fn run_front(
             Err(why) => fill_failed = Some(why),
         }
     }
-    // Front work spent by the attempts so far (see `front_work_budget`).
+    // Front work spent by the attempts so far (see `front_work_budget`), and their time.
     let mut spent = 0u64;
+    let mut discarded = 0.0;
     let attempts = if front_enabled() {
         RESTARTS.len()
     } else {
@@ -1386,22 +1392,27 @@ pub fn run_front(
         if fill_failed.is_none() {
             m.work_budget = front_work_budget(surf_tris.len()).saturating_sub(spent);
         }
-        match m.run(progress) {
+        let clock = std::time::Instant::now();
+        let run = m.run(progress);
+        match run {
             Ok(()) => {
                 // The live tets and their qualities.
                 let alive = |i: &usize| m.tet_alive[*i];
                 let live = || (0..m.tets.len()).filter(alive);
                 let tets: Vec<[u32; 4]> = live().map(|i| m.tets[i]).collect();
                 let quality: Vec<f64> = live().map(|i| m.tet_q[i]).collect();
+                let mut stats = m.stats;
+                stats.discarded_seconds = discarded;
                 return Ok(FrontOutput {
                     pts: m.pts,
                     tets,
                     quality,
-                    stats: m.stats,
+                    stats,
                 });
             }
             Err(Error::MeshingFailed { msg, partial }) => {
                 spent += m.work;
+                discarded += clock.elapsed().as_secs_f64();
                 failures.push(format!("alpha {:.3}, size x{fs}: {msg}", m.alpha));
                 last_partial = partial;
                 // A stalled front hands the region to the whole fill at once (tried once;
@@ -1415,7 +1426,10 @@ pub fn run_front(
                         attempt + 1,
                         progress,
                     )? {
-                        Ok(out) => return Ok(out),
+                        Ok(mut out) => {
+                            out.stats.discarded_seconds = discarded;
+                            return Ok(out);
+                        }
                         Err(why) => fill_failed = Some(why),
                     }
                 }
@@ -1430,7 +1444,10 @@ pub fn run_front(
     let why = match fill_failed {
         Some(why) => why,
         None => match whole_fill_stage(surf_nodes, surf_tris, opts, size, attempts, progress)? {
-            Ok(out) => return Ok(out),
+            Ok(mut out) => {
+                out.stats.discarded_seconds = discarded;
+                return Ok(out);
+            }
             Err(why) => why,
         },
     };
