@@ -1393,8 +1393,7 @@ pub fn run_front(
             m.work_budget = front_work_budget(surf_tris.len()).saturating_sub(spent);
         }
         let clock = std::time::Instant::now();
-        let run = m.run(progress);
-        match run {
+        match m.run(progress) {
             Ok(()) => {
                 // The live tets and their qualities.
                 let alive = |i: &usize| m.tet_alive[*i];
