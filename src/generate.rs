@@ -154,7 +154,6 @@ fn generate_inner(
     let mut dropped = 0.0;
     let (mut front_stats, mesh, ostats, conf, bad) = loop {
         let pass = Instant::now();
-        let t = Instant::now();
         let front = run_front(
             surface.nodes(),
             surface.triangles(),
@@ -164,7 +163,7 @@ fn generate_inner(
             progress,
         )
         .map_err(|e| with_shape_hint(e, surface))?;
-        times.front += t.elapsed().as_secs_f64();
+        times.front += pass.elapsed().as_secs_f64();
 
         let mut ostats = OptimizeStats::default();
         if opts.optimize && progress(0.0, "optimize") {

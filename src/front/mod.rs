@@ -1363,7 +1363,7 @@ pub fn run_front(
     // The whole fill's error, once it has been tried.
     let mut fill_failed: Option<String> = None;
     if first == 0 && fill_first(surf_nodes, surf_tris) {
-        match whole_fill_stage(surf_nodes, surf_tris, opts, size, 0, progress)? {
+        match whole_fill_stage(surf_nodes, surf_tris, opts, size, (0, 0.0), progress)? {
             Ok(mut out) => {
                 out.stats.fill_first = true;
                 return Ok(out);
@@ -1417,18 +1417,9 @@ pub fn run_front(
                 // A stalled front hands the region to the whole fill at once (tried once;
                 // where it fails, the next configuration runs).
                 if m.stalled && fill_failed.is_none() {
-                    match whole_fill_stage(
-                        surf_nodes,
-                        surf_tris,
-                        opts,
-                        size,
-                        attempt + 1,
-                        progress,
-                    )? {
-                        Ok(mut out) => {
-                            out.stats.discarded_seconds = discarded;
-                            return Ok(out);
-                        }
+                    let before = (attempt + 1, discarded);
+                    match whole_fill_stage(surf_nodes, surf_tris, opts, size, before, progress)? {
+                        Ok(out) => return Ok(out),
                         Err(why) => fill_failed = Some(why),
                     }
                 }
@@ -1442,13 +1433,13 @@ pub fn run_front(
     // Every attempt failed: the whole region at once, boundary kept.
     let why = match fill_failed {
         Some(why) => why,
-        None => match whole_fill_stage(surf_nodes, surf_tris, opts, size, attempts, progress)? {
-            Ok(mut out) => {
-                out.stats.discarded_seconds = discarded;
-                return Ok(out);
+        None => {
+            let before = (attempts, discarded);
+            match whole_fill_stage(surf_nodes, surf_tris, opts, size, before, progress)? {
+                Ok(out) => return Ok(out),
+                Err(why) => why,
             }
-            Err(why) => why,
-        },
+        }
     };
     Err(Error::MeshingFailed {
         msg: format!(
@@ -1460,15 +1451,15 @@ pub fn run_front(
     })
 }
 
-/// The whole fill of the region ([`whole_fill`]), after `attempts_run` front attempts
-/// (counted from the first configuration, those a caller skipped included). The inner
-/// Err says why it failed.
+/// The whole fill of the region ([`whole_fill`]), after `before`: the front attempts
+/// that ran (counted from the first configuration, those a caller skipped included) and
+/// the seconds they took, which its stats report. The inner Err says why it failed.
 fn whole_fill_stage(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
     opts: &Options,
     size: &SizeField,
-    attempts_run: usize,
+    before: (usize, f64),
     progress: Progress,
 ) -> Result<std::result::Result<FrontOutput, String>> {
     if progress(0.0, "whole fill") {
@@ -1476,7 +1467,8 @@ fn whole_fill_stage(
     }
     Ok(
         whole_fill::whole_fill(surf_nodes, surf_tris, size).map(|mut out| {
-            out.stats.restarts = attempts_run.saturating_sub(1) as u32;
+            out.stats.restarts = before.0.saturating_sub(1) as u32;
+            out.stats.discarded_seconds = before.1;
             out.stats.alpha = opts.alpha;
             out.stats.size_scale = 1.0;
             out
