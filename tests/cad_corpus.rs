@@ -123,6 +123,12 @@ fn corpus_part_meshes(name: &str, ntri: usize, chords: bool, unforced_at_most: u
     } else if f.whole_fill {
         assert!(f.discarded_seconds > 0.0, "{name}: {f:?}");
     }
+    // Every stage of the whole fill is timed on some try: the interior points on the
+    // first, the finish (contractions, lifts) on the try that filled only.
+    for (i, t) in f.whole_fill_tries.iter().enumerate() {
+        assert_eq!(t.points_seconds > 0.0, i == 0, "{name}: {f:?}");
+        assert_eq!(t.finish_seconds > 0.0, t.error.is_none(), "{name}: {f:?}");
+    }
     assert!(
         g.report.slivers.unforced <= unforced_at_most,
         "{name}: {:?}",

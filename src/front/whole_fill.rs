@@ -45,12 +45,15 @@ pub(crate) fn whole_fill(
     surf_tris: &[[u32; 6]],
     size: &SizeField,
 ) -> Result<FrontOutput, String> {
+    let clock = std::time::Instant::now();
     let FillInput {
         corners,
         pts,
         interior,
         faces,
     } = fill_input(surf_nodes, surf_tris, size)?;
+    // (On the first try's report.)
+    let mut placed = clock.elapsed().as_secs_f64();
     let n_corners = pts.len();
     // Thin tets on the surface get a point above it, at most a size high.
     let height = |p: P3| size.at(p);
@@ -106,6 +109,8 @@ pub(crate) fn whole_fill(
                 faces_seconds: stages.faces,
                 steiner_removal_seconds: stages.steiner_removal,
                 steiner_points: stages.steiner_points,
+                points_seconds: std::mem::take(&mut placed),
+                finish_seconds: stages.finish,
             });
             match r {
                 Ok(f) => {

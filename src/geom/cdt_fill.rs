@@ -65,6 +65,8 @@ pub(crate) struct Stages {
     pub faces: f64,
     pub steiner_removal: f64,
     pub steiner_points: usize,
+    /// Contractions, lifts and the result, after the Steiner points moved.
+    pub finish: f64,
     /// Steiner points that only the last round's larger cavities could move off the
     /// surface ([`GROW_LIMIT_LAST`]), or that stayed on it.
     pub wide_cavity_points: usize,
@@ -133,7 +135,9 @@ pub(crate) fn fill_from(
     if let Some(h) = height {
         c.lift_flat_tets(h);
     }
-    c.result()
+    let r = c.result();
+    stages.finish = lap();
+    r
 }
 
 /// A tet on a surface face with a dihedral angle below this (degrees) gets a point above
