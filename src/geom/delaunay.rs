@@ -609,8 +609,11 @@ impl Delaunay {
     /// only tets `keep` accepts. Linear in the star's size: a cospherical ring (a
     /// cylinder's cap of many facets) gives a point thousands of tets.
     pub(crate) fn walk_around(&self, v: u32, t0: u32, keep: impl Fn(u32) -> bool) -> Vec<u32> {
-        let mut out = vec![t0];
-        let mut seen: HashSet<u32> = HashSet::from_iter([t0]);
+        let mut out = Vec::with_capacity(64);
+        out.push(t0);
+        // (A vertex's star is some 20-100 tets: sized for it, the set rarely grows.)
+        let mut seen: HashSet<u32> = HashSet::with_capacity_and_hasher(64, Default::default());
+        seen.insert(t0);
         let mut k = 0;
         while k < out.len() {
             let t = out[k];
@@ -758,7 +761,10 @@ impl Delaunay {
             (0..4).all(|j| dt.positive(new_tet(dt, t, j)) || on_face(dt, t, j))
         };
         let mut cav = vec![start];
-        let mut in_cav: HashSet<u32> = HashSet::from_iter([start]);
+        // (Sized for a typical cavity, so that the sets rarely grow: their rehashing
+        // showed in profiles of the fill.)
+        let mut in_cav: HashSet<u32> = HashSet::with_capacity_and_hasher(64, Default::default());
+        in_cav.insert(start);
         // `take` and the tets it brings in through faces p does not see.
         let mut forced: HashSet<u32> = HashSet::default();
         if let Some(t) = take {
@@ -795,8 +801,10 @@ impl Delaunay {
         };
         loop {
             let mut out: Vec<u32> = Vec::new();
-            let mut bound_edges: HashSet<[u32; 2]> = HashSet::default();
-            let mut bound_pts: HashSet<u32> = HashSet::default();
+            let mut bound_edges: HashSet<[u32; 2]> =
+                HashSet::with_capacity_and_hasher(4 * cav.len() + 8, Default::default());
+            let mut bound_pts: HashSet<u32> =
+                HashSet::with_capacity_and_hasher(2 * cav.len() + 8, Default::default());
             for &t in &cav {
                 for j in 0..4 {
                     let nb = self.adj[t as usize][j];
