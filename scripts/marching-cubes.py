@@ -2,8 +2,9 @@
 # Marching-cubes surfaces of implicit shapes, raw, as an image segmentation pipeline
 # gives them (needle and cap triangles):
 #     scripts/marching-cubes.py N SHAPE out.off   (N grid points per axis; needs
-#     scikit-image). tests/data/mc_blob.off is `22 blob`. Mesh them with --smooth 10
-#     (docs/cli.md and docs/benchmarks.md, "Surfaces from image segmentation").
+#     scikit-image and its scipy). tests/data/mc_blob.off is `22 blob`. Mesh them
+#     with --smooth 10 (docs/cli.md and docs/benchmarks.md, "Surfaces from image
+#     segmentation").
 # SHAPE: sphere, blob, peanut; and, kept out of the tests as an unseen check of the
 # mesher on raw surfaces (the largest component is kept): gyroball (a thickened gyroid
 # sheet in a ball, genus > 10), twotori (two crossing tori blended), holeybox (a cube
@@ -36,19 +37,14 @@ if shape in ('gyroball', 'twotori', 'holeybox'):
 verts, faces, _, _ = measure.marching_cubes(F, 0.0, spacing=(x[1]-x[0],)*3)
 verts -= 1.3
 # The largest edge-connected component only.
-parent = np.arange(len(verts))
-def find(a):
-    while parent[a] != a:
-        parent[a] = parent[parent[a]]
-        a = parent[a]
-    return a
-for t in faces:
-    for k in range(3):
-        a, b = find(t[k]), find(t[(k + 1) % 3])
-        if a != b:
-            parent[a] = b
-roots = np.array([find(t[0]) for t in faces])
-faces = faces[roots == np.bincount(roots).argmax()]
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+_, label = connected_components(
+    coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])), shape=(len(verts),) * 2),
+    directed=False)
+comp = label[faces[:, 0]]
+faces = faces[comp == np.bincount(comp).argmax()]
 used = np.unique(faces)
 renum = np.full(len(verts), -1)
 renum[used] = np.arange(len(used))
