@@ -8,6 +8,7 @@ use crate::geom::shape::TET10_EDGES;
 use crate::geom::vec3::{mid, P3};
 use crate::mesh::report::{uncertified, QualityReport};
 use crate::mesh::{build, check, TetMesh};
+use crate::optimize::high_order::reoptimize_high_order_near;
 use crate::optimize::{
     improve_linear_known, optimize_high_order, Boundary, HighOrderParams, LinearParams,
     OptimizeStats,
@@ -238,9 +239,17 @@ fn generate_inner(
         if conf.is_ok() && !bad.is_empty() {
             let t = Instant::now();
             let (n_surf, chords) = (surface.nodes().len(), surface.chords_allowed());
-            let redo = |m: &mut TetMesh, optimize: bool| {
-                if optimize && opts.optimize {
-                    pool.install(|| optimize_high_order(m, &bnd, &high_order_params(opts)));
+            let prm = high_order_params(opts);
+            let redo = |m: &mut TetMesh, again: Reoptimize| {
+                match again {
+                    _ if !opts.optimize => {}
+                    Reoptimize::Everywhere => {
+                        pool.install(|| optimize_high_order(m, &bnd, &prm));
+                    }
+                    Reoptimize::Near(moved) => {
+                        pool.install(|| reoptimize_high_order_near(m, &bnd, &prm, moved));
+                    }
+                    Reoptimize::No => {}
                 }
                 pool.install(|| uncertified(m))
             };
@@ -315,12 +324,27 @@ const CHORD_ROUNDS: usize = 4;
 /// Rounds of [`straighten_uncertified`] after those, that only certify again.
 const STRAIGHT_ROUNDS: usize = 12;
 
+/// What a round of [`straighten_uncertified`] asks its `redo` to optimize again before
+/// it certifies.
+#[derive(Clone, Copy, Debug)]
+enum Reoptimize<'a> {
+    /// The whole mesh (the first round, after the edges of every uncertified element
+    /// went straight).
+    Everywhere,
+    /// Only near these nodes, the mid nodes the round straightened: the rest of the mesh
+    /// is as the last optimization left it, and optimizing it all again would repeat
+    /// that work for the few elements left.
+    Near(&'a [u32]),
+    /// Nothing: certify only.
+    No,
+}
+
 /// Where elements are left uncertified, put the mid nodes of their edges back on the
 /// chords and optimize and certify again (`redo`, which returns the elements still
-/// uncertified into `bad`; its flag says whether to optimize); a few rounds, while some
-/// are left with curved edges. An interior edge always may; a boundary edge only on a
-/// surface curved from a linear one (`chords`: [`Surface::chords_allowed`]), whose own
-/// edges are the straight ones.
+/// uncertified into `bad`; [`Reoptimize`] says where it optimizes again); a few rounds,
+/// while some are left with curved edges. An interior edge always may; a
+/// boundary edge only on a surface curved from a linear one (`chords`:
+/// [`Surface::chords_allowed`]), whose own edges are the straight ones.
 ///
 /// The first [`CHORD_ROUNDS`] optimize again, which can bend the straightened interior
 /// edges once more, so that each round leaves some elements uncertified again; the next
@@ -338,7 +362,7 @@ fn straighten_uncertified(
     n_surf: usize,
     chords: bool,
     bad: &mut Vec<usize>,
-    mut redo: impl FnMut(&mut TetMesh, bool) -> Vec<usize>,
+    mut redo: impl FnMut(&mut TetMesh, Reoptimize) -> Vec<usize>,
 ) -> [usize; 2] {
     let mut straightened = [0, 0];
     for round in 0..CHORD_ROUNDS + STRAIGHT_ROUNDS {
@@ -359,13 +383,20 @@ fn straighten_uncertified(
         if moves.is_empty() {
             break;
         }
+        let mut moved = Vec::with_capacity(moves.len());
         for (m, c, boundary) in moves {
             if mesh.nodes[m] != c {
                 mesh.nodes[m] = c;
                 straightened[usize::from(!boundary)] += 1;
+                moved.push(m as u32);
             }
         }
-        *bad = redo(mesh, round < CHORD_ROUNDS);
+        let again = match round {
+            0 => Reoptimize::Everywhere,
+            r if r < CHORD_ROUNDS => Reoptimize::Near(&moved),
+            _ => Reoptimize::No,
+        };
+        *bad = redo(mesh, again);
         if bad.is_empty() {
             break;
         }
@@ -601,19 +632,20 @@ mod tests {
         let mut mesh = thin_tet(mid(A, B), bent);
         let mut bad = uncertified(&mesh);
         assert_eq!(bad, vec![0]);
-        let mut optimized = 0;
-        let redo = |m: &mut TetMesh, optimize: bool| {
-            if optimize {
-                optimized += 1;
+        let mut optimized = Vec::new();
+        let redo = |m: &mut TetMesh, again: Reoptimize| {
+            if !matches!(again, Reoptimize::No) {
+                optimized.push(format!("{again:?}"));
                 m.nodes[7] = bent;
             }
             uncertified(m)
         };
         straighten_uncertified(&mut mesh, 6, false, &mut bad, redo);
-        assert_eq!(
-            optimized, CHORD_ROUNDS,
-            "every optimizing round ran and bent it back"
-        );
+        // Every optimizing round ran and bent it back: the first everywhere, the next
+        // ones near the node they straightened.
+        let mut expected = vec!["Everywhere".to_string()];
+        expected.resize(CHORD_ROUNDS, "Near([7])".to_string());
+        assert_eq!(optimized, expected);
         assert!(bad.is_empty(), "{bad:?}");
         assert_eq!(mesh.nodes[7], mid(D, A));
     }

@@ -220,6 +220,30 @@ pub fn optimize_high_order(
     bnd: &Boundary,
     prm: &HighOrderParams,
 ) -> HighOrderStats {
+    optimize_seeded(mesh, bnd, prm, None)
+}
+
+/// [`optimize_high_order`] again after the nodes `moved` moved (a mesh it optimized
+/// before): only the elements containing one of them seed patches. Elsewhere the mesh is
+/// as the last run left it, and optimizing it again would repeat that run's work for
+/// little or nothing.
+pub(crate) fn reoptimize_high_order_near(
+    mesh: &mut TetMesh,
+    bnd: &Boundary,
+    prm: &HighOrderParams,
+    moved: &[u32],
+) -> HighOrderStats {
+    optimize_seeded(mesh, bnd, prm, Some(moved))
+}
+
+/// [`optimize_high_order`], with patches seeded only by elements containing a node of
+/// `near` where given.
+fn optimize_seeded(
+    mesh: &mut TetMesh,
+    bnd: &Boundary,
+    prm: &HighOrderParams,
+    near: Option<&[u32]>,
+) -> HighOrderStats {
     let mut st = HighOrderStats::default();
     let ne = mesh.tets.len();
     let all: Vec<u32> = (0..ne as u32).collect();
@@ -237,6 +261,19 @@ pub fn optimize_high_order(
     st.invalid[0] = i0;
     st.below_threshold[0] = b0;
     let adj = NodeElems::new(mesh);
+    // Elements that may seed a patch.
+    let seeding: Vec<bool> = match near {
+        None => vec![true; ne],
+        Some(nodes) => {
+            let mut m = vec![false; ne];
+            for &n in nodes {
+                for &e in adj.of(n) {
+                    m[e as usize] = true;
+                }
+            }
+            m
+        }
+    };
     let mut marks = Marks::new(ne, mesh.nodes.len());
     let direct = m0 >= prm.reach_below;
     // Set once a round improved nothing with vertices held back: from then on vertices
@@ -272,7 +309,7 @@ pub fn optimize_high_order(
             },
         };
         let mut seeds: Vec<u32> = (0..ne as u32)
-            .filter(|&t| sj[t as usize] < rp.threshold)
+            .filter(|&t| seeding[t as usize] && sj[t as usize] < rp.threshold)
             .collect();
         if seeds.is_empty() {
             break;
@@ -873,6 +910,39 @@ mod tests {
         let st = optimize_high_order(&mut b, &bnd, &none);
         assert_eq!(st.rounds, 0);
         assert!(!uncertified(&b).is_empty());
+    }
+
+    #[test]
+    fn optimizing_again_near_moved_nodes_leaves_the_rest_alone() {
+        let c = cube(6, 0.08);
+        let bnd = c.boundary();
+        let base = c.p2_perturbed(3, 0.04);
+        let prm = HighOrderParams::default();
+        // The interior mid node nearest a corner of the cube: patches around its elements
+        // (two layers) stay within half the cube.
+        let adj = NodeElems::new(&base);
+        let near = (c.n_surf..base.nodes.len())
+            .filter(|&n| !adj.is_vertex[n])
+            .min_by(|&a, &b| {
+                dist(base.nodes[a], [0.0; 3]).total_cmp(&dist(base.nodes[b], [0.0; 3]))
+            })
+            .unwrap() as u32;
+        // Nodes in the far corner octant of the cube that moved.
+        let far_moved = |m: &TetMesh| {
+            (0..m.nodes.len())
+                .filter(|&n| base.nodes[n].iter().all(|&x| x > 0.6))
+                .filter(|&n| m.nodes[n].map(f64::to_bits) != base.nodes[n].map(f64::to_bits))
+                .count()
+        };
+        let mut a = base.clone();
+        let st = reoptimize_high_order_near(&mut a, &bnd, &prm, &[near]);
+        assert!(st.patches_improved > 0, "{st:?}");
+        assert_ne!(a.nodes[near as usize], base.nodes[near as usize]);
+        assert_eq!(far_moved(&a), 0);
+        // Everywhere, the far nodes move too.
+        let mut b = base.clone();
+        optimize_high_order(&mut b, &bnd, &prm);
+        assert!(far_moved(&b) > 0);
     }
 
     #[test]
