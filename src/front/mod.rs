@@ -1370,7 +1370,7 @@ pub fn run_front(
     // The whole fill's error, once it has been tried.
     let mut fill_failed: Option<String> = None;
     if first == 0 && fill_first(surf_nodes, surf_tris) {
-        match whole_fill_stage(surf_nodes, surf_tris, opts, size, (0, 0.0), progress)? {
+        match whole_fill_stage(surf_nodes, surf_tris, opts, size, Dropped::NONE, progress)? {
             Ok(mut out) => {
                 out.stats.fill_first = true;
                 return Ok(out);
@@ -1424,7 +1424,10 @@ pub fn run_front(
                 // A stalled front hands the region to the whole fill at once (tried once;
                 // where it fails, the next configuration runs).
                 if m.stalled && fill_failed.is_none() {
-                    let before = (attempt + 1, discarded);
+                    let before = Dropped {
+                        attempts: attempt + 1,
+                        seconds: discarded,
+                    };
                     match whole_fill_stage(surf_nodes, surf_tris, opts, size, before, progress)? {
                         Ok(out) => return Ok(out),
                         Err(why) => fill_failed = Some(why),
@@ -1441,7 +1444,10 @@ pub fn run_front(
     let why = match fill_failed {
         Some(why) => why,
         None => {
-            let before = (attempts, discarded);
+            let before = Dropped {
+                attempts,
+                seconds: discarded,
+            };
             match whole_fill_stage(surf_nodes, surf_tris, opts, size, before, progress)? {
                 Ok(out) => return Ok(out),
                 Err(why) => why,
@@ -1458,15 +1464,32 @@ pub fn run_front(
     })
 }
 
-/// The whole fill of the region ([`whole_fill`]), after `before`: the front attempts
-/// that ran (counted from the first configuration, those a caller skipped included) and
-/// the seconds they took, which its stats report. The inner Err says why it failed.
+/// The front attempts whose meshes were dropped before the whole fill ran, which its
+/// stats report.
+#[derive(Clone, Copy, Debug)]
+struct Dropped {
+    /// Attempts, counted from the first configuration (those a caller skipped included).
+    attempts: usize,
+    /// Seconds the attempts run here took.
+    seconds: f64,
+}
+
+impl Dropped {
+    /// The whole fill ran first.
+    const NONE: Dropped = Dropped {
+        attempts: 0,
+        seconds: 0.0,
+    };
+}
+
+/// The whole fill of the region ([`whole_fill`]), after the front attempts `before`.
+/// The inner Err says why it failed.
 fn whole_fill_stage(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
     opts: &Options,
     size: &SizeField,
-    before: (usize, f64),
+    before: Dropped,
     progress: Progress,
 ) -> Result<std::result::Result<FrontOutput, String>> {
     if progress(0.0, "whole fill") {
@@ -1474,8 +1497,8 @@ fn whole_fill_stage(
     }
     Ok(
         whole_fill::whole_fill(surf_nodes, surf_tris, size).map(|mut out| {
-            out.stats.restarts = before.0.saturating_sub(1) as u32;
-            out.stats.discarded_seconds = before.1;
+            out.stats.restarts = before.attempts.saturating_sub(1) as u32;
+            out.stats.discarded_seconds = before.seconds;
             out.stats.alpha = opts.alpha;
             out.stats.size_scale = 1.0;
             out
