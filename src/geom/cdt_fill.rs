@@ -1100,7 +1100,10 @@ impl<'a> Cdt<'a> {
                 for k in steps.clone() {
                     let p = axpy(ps, base * 0.5f64.powi(k) / l, d);
                     self.dt.pts[q as usize] = p;
-                    if let Some((cav, new)) = self.grown_star(s, q, comp, &faces) {
+                    // Only a cavity smaller than the best so far can replace it: growing
+                    // one stops past that size.
+                    let most = best.as_ref().map_or(self.grow_limit, |b| b.1.len() - 1);
+                    if let Some((cav, new)) = self.grown_star(s, q, comp, &faces, most) {
                         if best.as_ref().map_or(true, |b| cav.len() < b.1.len()) {
                             best = Some((p, cav, new));
                         }
@@ -1165,20 +1168,25 @@ impl<'a> Cdt<'a> {
     /// does not see strictly (positively) is crossed into the tet behind it, Bowyer-Watson
     /// fashion, until `q` sees them all: the cavity is then star-shaped from `q`, so the
     /// new tets fill it. None where the face to cross is a surface face, the tet behind it
-    /// has `s` (another pocket), the cavity passes [`Cdt::grow_limit`] tets, or `q` is not
-    /// strictly inside `faces`; interior points the cavity swallows are dropped.
+    /// has `s` (another pocket), the cavity grows past `most` tets (at most
+    /// [`Cdt::grow_limit`]), or `q` is not strictly inside `faces`; interior points the
+    /// cavity swallows are dropped.
     fn grown_star(
         &self,
         s: u32,
         q: u32,
         comp: &[u32],
         faces: &[[u32; 4]],
+        most: usize,
     ) -> Option<(Vec<u32>, Vec<[u32; 4]>)> {
         if !faces.iter().all(|&t| self.dt.positive(t)) {
             return None;
         }
         let mut cavity: Vec<u32> = comp.to_vec();
-        let mut inside: HashSet<u32> = cavity.iter().copied().collect();
+        // (Sized for a cavity several times the star's: it rarely grows then.)
+        let mut inside: HashSet<u32> =
+            HashSet::with_capacity_and_hasher(4 * comp.len(), Default::default());
+        inside.extend(cavity.iter().copied());
         // The faces at `s` are inside the star or are the surface faces `faces` replace.
         let at_s = |tv: [u32; 4], k: usize| tv[k] != s && tv.contains(&s);
         // Each face is tested when its tet joins; a face seen stays seen, or becomes
@@ -1203,7 +1211,7 @@ impl<'a> Cdt<'a> {
             }
             inside.insert(nb);
             cavity.push(nb);
-            if cavity.len() > self.grow_limit {
+            if cavity.len() > most {
                 return None;
             }
             todo.extend((0..4).map(|k| (nb, k)));
