@@ -258,7 +258,8 @@ fn generate_inner(
             if ostats.chords > 0 {
                 conf = pool.install(|| check::check_conformity(&mesh));
             }
-            times.optimize += t.elapsed().as_secs_f64();
+            ostats.time_chords = t.elapsed().as_secs_f64();
+            times.optimize += ostats.time_chords;
             // Tests only: a fault on every attempt is put back after the repair above,
             // so that it still reaches the final check.
             if fault_persists() {

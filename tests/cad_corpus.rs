@@ -129,6 +129,19 @@ fn corpus_part_meshes(name: &str, ntri: usize, chords: bool, unforced_at_most: u
         assert_eq!(t.points_seconds > 0.0, i == 0, "{name}: {f:?}");
         assert_eq!(t.finish_seconds > 0.0, t.error.is_none(), "{name}: {f:?}");
     }
+    // The optimization's stages account for all its time (where no restart dropped a
+    // pass), the straightening included where it put edges on their chords.
+    let o = &g.optimize;
+    if f.restarts == 0 {
+        assert_eq!(
+            g.times.optimize,
+            o.time_linear + o.time_high_order + o.time_chords,
+            "{name}"
+        );
+    }
+    if o.chords + o.interior_chords > 0 {
+        assert!(o.time_chords > 0.0, "{name}: {o:?}");
+    }
     assert!(
         g.report.slivers.unforced <= unforced_at_most,
         "{name}: {:?}",

@@ -37,6 +37,10 @@ pub struct OptimizeStats {
     pub time_linear: f64,
     /// Wall-clock seconds of the high-order stage.
     pub time_high_order: f64,
+    /// Wall-clock seconds of putting the edges of uncertified elements back on their
+    /// chords, with the optimizing and certifying again that goes with it (0 where the
+    /// high-order stage left every element certified).
+    pub time_chords: f64,
     /// Boundary edges put back on their chords (a surface curved from a linear one)
     /// where curved elements could not be certified.
     pub chords: usize,
