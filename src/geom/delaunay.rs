@@ -13,6 +13,7 @@
 use super::predicates::orient3d;
 use super::vec3::P3;
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
+use std::cell::RefCell;
 
 /// No tet (a hull face's outer neighbour).
 pub(crate) const NONE: u32 = u32::MAX;
@@ -76,6 +77,31 @@ pub(crate) struct Delaunay {
     /// The largest absolute coordinate of the input points: the scale of the rounding
     /// of every point added on an input edge or face ([`Delaunay::clearly_solid`]).
     magnitude: f64,
+    /// The tets [`Delaunay::walk_around`] has reached, reused from walk to walk (a hash
+    /// set per walk cost more than the walk itself).
+    walked: RefCell<Stamps>,
+}
+
+/// Per-tet marks, each walk's with a new stamp: clearing them is one increment.
+#[derive(Clone, Default)]
+struct Stamps {
+    stamp: u32,
+    of: Vec<u32>,
+}
+
+impl Stamps {
+    /// A new stamp, with a mark slot for each of `n` tets.
+    fn next(&mut self, n: usize) -> u32 {
+        if self.of.len() < n {
+            self.of.resize(n, 0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.of.fill(0);
+            self.stamp = 1;
+        }
+        self.stamp
+    }
 }
 
 impl Delaunay {
@@ -136,6 +162,7 @@ impl Delaunay {
             fixed_faces: HashSet::default(),
             last: 0,
             magnitude: pts.iter().flatten().fold(0.0, |m, x| m.max(x.abs())),
+            walked: RefCell::default(),
         };
         for i in 0..n as u32 {
             dt.insert(i);
@@ -611,9 +638,9 @@ impl Delaunay {
     pub(crate) fn walk_around(&self, v: u32, t0: u32, keep: impl Fn(u32) -> bool) -> Vec<u32> {
         let mut out = Vec::with_capacity(64);
         out.push(t0);
-        // (A vertex's star is some 20-100 tets: sized for it, the set rarely grows.)
-        let mut seen: HashSet<u32> = HashSet::with_capacity_and_hasher(64, Default::default());
-        seen.insert(t0);
+        let mut seen = self.walked.borrow_mut();
+        let stamp = seen.next(self.tets.len());
+        seen.of[t0 as usize] = stamp;
         let mut k = 0;
         while k < out.len() {
             let t = out[k];
@@ -624,7 +651,8 @@ impl Delaunay {
                     continue;
                 }
                 let nb = self.adj[t as usize][j];
-                if nb != NONE && keep(nb) && seen.insert(nb) {
+                if nb != NONE && keep(nb) && seen.of[nb as usize] != stamp {
+                    seen.of[nb as usize] = stamp;
                     out.push(nb);
                 }
             }
