@@ -1183,10 +1183,12 @@ impl<'a> Cdt<'a> {
             return None;
         }
         let mut cavity: Vec<u32> = comp.to_vec();
-        // (Sized for a cavity several times the star's: it rarely grows then.)
-        let mut inside: HashSet<u32> =
-            HashSet::with_capacity_and_hasher(4 * comp.len(), Default::default());
-        inside.extend(cavity.iter().copied());
+        // (Only orientation tests below: no star walk needs the marks meanwhile.)
+        let mut inside = self.dt.tet_marks();
+        inside.clear_for(self.dt.tets.len());
+        for &t in &cavity {
+            inside.insert(t);
+        }
         // The faces at `s` are inside the star or are the surface faces `faces` replace.
         let at_s = |tv: [u32; 4], k: usize| tv[k] != s && tv.contains(&s);
         // Each face is tested when its tet joins; a face seen stays seen, or becomes
@@ -1198,7 +1200,7 @@ impl<'a> Cdt<'a> {
         while let Some((t, k)) = todo.pop() {
             let tv = self.dt.tets[t as usize];
             let nb = self.dt.adj[t as usize][k];
-            if at_s(tv, k) || (nb != NONE && inside.contains(&nb)) {
+            if at_s(tv, k) || (nb != NONE && inside.contains(nb)) {
                 continue;
             }
             let mut nt = tv;
@@ -1221,7 +1223,7 @@ impl<'a> Cdt<'a> {
             let tv = self.dt.tets[t as usize];
             for k in 0..4 {
                 let nb = self.dt.adj[t as usize][k];
-                if !at_s(tv, k) && (nb == NONE || !inside.contains(&nb)) {
+                if !at_s(tv, k) && (nb == NONE || !inside.contains(nb)) {
                     let mut nt = tv;
                     nt[k] = q;
                     new.push(nt);

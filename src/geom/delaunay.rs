@@ -84,12 +84,31 @@ pub(crate) struct Delaunay {
 
 /// Per-tet marks, each walk's with a new stamp: clearing them is one increment.
 #[derive(Clone, Default)]
-struct Stamps {
+pub(crate) struct Stamps {
     stamp: u32,
     of: Vec<u32>,
 }
 
 impl Stamps {
+    /// Start an empty set of tets with ids below `n` (the marks of the last set no
+    /// longer count).
+    pub(crate) fn clear_for(&mut self, n: usize) {
+        self.next(n);
+    }
+
+    /// Mark tet `t` (below the `n` of [`Stamps::clear_for`]); true when it was not.
+    pub(crate) fn insert(&mut self, t: u32) -> bool {
+        let m = &mut self.of[t as usize];
+        let new = *m != self.stamp;
+        *m = self.stamp;
+        new
+    }
+
+    /// Whether tet `t` is marked.
+    pub(crate) fn contains(&self, t: u32) -> bool {
+        self.of.get(t as usize) == Some(&self.stamp)
+    }
+
     /// A new stamp, with a mark slot for each of `n` tets.
     fn next(&mut self, n: usize) -> u32 {
         if self.of.len() < n {
@@ -632,6 +651,12 @@ impl Delaunay {
         self.walk_around(v, t0, |_| true)
     }
 
+    /// The marks [`Delaunay::walk_around`] uses, for a caller's own set of tets; no walk
+    /// may run while they are held (it would panic).
+    pub(crate) fn tet_marks(&self) -> std::cell::RefMut<'_, Stamps> {
+        self.walked.borrow_mut()
+    }
+
     /// The tets containing vertex `v` reached from `t0` across faces through `v`, entering
     /// only tets `keep` accepts. Linear in the star's size: a cospherical ring (a
     /// cylinder's cap of many facets) gives a point thousands of tets.
@@ -1122,6 +1147,23 @@ mod tests {
         *seed ^= *seed >> 7;
         *seed ^= *seed << 17;
         (*seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn stamps_start_each_set_empty_even_when_the_stamp_wraps() {
+        let mut m = Stamps::default();
+        m.clear_for(4);
+        assert!(m.insert(2) && !m.insert(2));
+        assert!(m.contains(2) && !m.contains(1) && !m.contains(9));
+        m.clear_for(6);
+        assert!(!m.contains(2));
+        assert!(m.insert(5));
+        // The stamp wraps: marks of every earlier set are cleared, not taken as current.
+        m.stamp = u32::MAX;
+        m.of[3] = 1;
+        m.clear_for(6);
+        assert_eq!(m.stamp, 1);
+        assert!(!m.contains(3) && !m.contains(5));
     }
 
     fn check_delaunay(dt: &Delaunay) {
