@@ -343,9 +343,9 @@ enum Reoptimize<'a> {
 /// Where elements are left uncertified, put the mid nodes of their edges back on the
 /// chords and optimize and certify again (`redo`, which returns the elements still
 /// uncertified into `bad`; [`Reoptimize`] says where it optimizes again); a few rounds,
-/// while some are left with curved edges. An interior edge always may; a
-/// boundary edge only on a surface curved from a linear one (`chords`:
-/// [`Surface::chords_allowed`]), whose own edges are the straight ones.
+/// while some are left with curved edges. An interior edge always may; a boundary edge
+/// only on a surface curved from a linear one (`chords`: [`Surface::chords_allowed`]),
+/// whose own edges are the straight ones.
 ///
 /// The first [`CHORD_ROUNDS`] optimize again, which can bend the straightened interior
 /// edges once more, so that each round leaves some elements uncertified again; the next
