@@ -241,15 +241,14 @@ fn generate_inner(
             let (n_surf, chords) = (surface.nodes().len(), surface.chords_allowed());
             let prm = high_order_params(opts);
             let redo = |m: &mut TetMesh, again: Reoptimize| {
-                match again {
-                    _ if !opts.optimize => {}
-                    Reoptimize::Everywhere => {
+                match (opts.optimize, again) {
+                    (true, Reoptimize::Everywhere) => {
                         pool.install(|| optimize_high_order(m, &bnd, &prm));
                     }
-                    Reoptimize::Near(moved) => {
+                    (true, Reoptimize::Near(moved)) => {
                         pool.install(|| reoptimize_high_order_near(m, &bnd, &prm, moved));
                     }
-                    Reoptimize::No => {}
+                    _ => {}
                 }
                 pool.install(|| uncertified(m))
             };

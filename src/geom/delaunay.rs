@@ -90,10 +90,17 @@ pub(crate) struct Stamps {
 }
 
 impl Stamps {
-    /// Start an empty set of tets with ids below `n` (the marks of the last set no
-    /// longer count).
+    /// Start an empty set of tets with ids below `n`: a new stamp, so that the marks of
+    /// the last set no longer count.
     pub(crate) fn clear_for(&mut self, n: usize) {
-        self.next(n);
+        if self.of.len() < n {
+            self.of.resize(n, 0);
+        }
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.of.fill(0);
+            self.stamp = 1;
+        }
     }
 
     /// Mark tet `t` (below the `n` of [`Stamps::clear_for`]); true when it was not.
@@ -107,19 +114,6 @@ impl Stamps {
     /// Whether tet `t` is marked.
     pub(crate) fn contains(&self, t: u32) -> bool {
         self.of.get(t as usize) == Some(&self.stamp)
-    }
-
-    /// A new stamp, with a mark slot for each of `n` tets.
-    fn next(&mut self, n: usize) -> u32 {
-        if self.of.len() < n {
-            self.of.resize(n, 0);
-        }
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.of.fill(0);
-            self.stamp = 1;
-        }
-        self.stamp
     }
 }
 
@@ -664,8 +658,8 @@ impl Delaunay {
         let mut out = Vec::with_capacity(64);
         out.push(t0);
         let mut seen = self.walked.borrow_mut();
-        let stamp = seen.next(self.tets.len());
-        seen.of[t0 as usize] = stamp;
+        seen.clear_for(self.tets.len());
+        seen.insert(t0);
         let mut k = 0;
         while k < out.len() {
             let t = out[k];
@@ -676,8 +670,7 @@ impl Delaunay {
                     continue;
                 }
                 let nb = self.adj[t as usize][j];
-                if nb != NONE && keep(nb) && seen.of[nb as usize] != stamp {
-                    seen.of[nb as usize] = stamp;
+                if nb != NONE && keep(nb) && seen.insert(nb) {
                     out.push(nb);
                 }
             }
