@@ -365,8 +365,7 @@ fn unforced_sliver_passes(
 /// their chords unless something makes those tets valid first ([`LinearParams::chords`]).
 /// (A straight one among them is its own chord: taking it as one changes nothing.)
 fn doomed_edges(m: &LinMesh) -> rustc_hash::FxHashSet<(u32, u32)> {
-    use crate::geom::predicates::orient3d;
-    use crate::geom::tet_quality::numerically_flat;
+    use crate::geom::tet_quality::positive_and_not_flat;
     let mut out = rustc_hash::FxHashSet::default();
     for (t, &q) in m.q.iter().enumerate() {
         if q > 0.0 || !m.alive(t as u32) {
@@ -374,7 +373,7 @@ fn doomed_edges(m: &LinMesh) -> rustc_hash::FxHashSet<(u32, u32)> {
         }
         let tv = m.tets[t];
         let c = m.corners(tv);
-        if orient3d(c[0], c[1], c[2], c[3]) <= 0 || numerically_flat(&c) {
+        if !positive_and_not_flat(&c) {
             continue;
         }
         for [i, j] in TET10_EDGES {

@@ -8,10 +8,9 @@
 
 use super::mesh::opposite_edge;
 use crate::geom::bezier::{certify, fixed_coefficients_positive, jacobian_bounds, LinearJacobian};
-use crate::geom::predicates::orient3d;
 use crate::geom::shape::TET10_EDGES;
 use crate::geom::tet_quality::{
-    dihedral_at_edge, dihedral_extremes, numerically_flat, skewness_from_extremes,
+    dihedral_at_edge, dihedral_extremes, positive_and_not_flat, skewness_from_extremes,
     EQUIANGULAR_DIHEDRAL_DEG,
 };
 use crate::geom::vec3::P3;
@@ -90,7 +89,7 @@ impl ElementQuality {
     ) -> (f64, f64) {
         // A numerically flat tet scores as an inverted one: its Jacobian cannot be
         // certified, so the stage never makes one and works to remove those it is given.
-        if orient3d(c[0], c[1], c[2], c[3]) <= 0 || numerically_flat(c) {
+        if !positive_and_not_flat(c) {
             return (f64::NEG_INFINITY, f64::NAN);
         }
         let (lo, hi) = dihedral_extremes(c);
