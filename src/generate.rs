@@ -172,20 +172,17 @@ fn generate_inner(
         }
         let (pts, tets) = if opts.optimize {
             let t = Instant::now();
-            let (pts, tets, st) = improve_linear_known(
-                front.pts,
-                front.tets,
-                Some(&front.quality),
-                &bnd,
-                &LinearParams {
-                    chords: surface.chords_allowed(),
-                    ..if front.stats.whole_fill {
-                        LinearParams::for_whole_fill()
-                    } else {
-                        LinearParams::default()
-                    }
-                },
-            );
+            let prm = LinearParams {
+                chords: surface.chords_allowed(),
+                ..if front.stats.whole_fill {
+                    LinearParams::for_whole_fill()
+                } else {
+                    LinearParams::default()
+                }
+            };
+            let (pts, tets, st) = pool.install(|| {
+                improve_linear_known(front.pts, front.tets, Some(&front.quality), &bnd, &prm)
+            });
             ostats.linear = st;
             ostats.time_linear = t.elapsed().as_secs_f64();
             (pts, tets)

@@ -10,8 +10,10 @@
 //! vertices (the smoother's ascent stalls at kinks of the max-min), followed by passes
 //! aimed at that threshold. The attempts over all passes are bounded by
 //! [`LinearParams::max_attempts_per_tet`]; where a pass leaves more bad tets than it
-//! found, later passes aim at the worst tets only ([`LinearParams::reach`]). Sequential
-//! and deterministic.
+//! found, later passes aim at the worst tets only ([`LinearParams::reach`]).
+//! Deterministic: sequential but for the trial points of a vertex search, which run on
+//! the threads of the rayon pool the stage is called in, with the same result on any
+//! number.
 
 mod contract;
 mod flips;

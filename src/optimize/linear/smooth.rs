@@ -9,6 +9,7 @@ use super::mesh::LinMesh;
 use super::objective::skew_pieces;
 use crate::geom::tet_quality::EQUIANGULAR_DIHEDRAL_DEG;
 use crate::geom::vec3::{dist2, dot, norm, P3};
+use rayon::prelude::*;
 
 /// Tuning of the smoother.
 #[derive(Clone, Copy, Debug)]
@@ -289,7 +290,9 @@ pub(super) fn smooth_vertex(
 /// stuck in a poor local optimum of [`smooth_vertex`] (max-min quality is not smooth and
 /// ascent stops at a kink): shrinking rings of trial points around the best position so
 /// far, the best kept only if its star's minimum quality rose. Deterministic (a fixed
-/// low-discrepancy sequence). Returns true when it moved.
+/// low-discrepancy sequence); a ring's trials run on the threads of the rayon pool it is
+/// called in, and the result does not depend on their number. Returns true when it
+/// moved.
 pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> bool {
     if m.bnd.is_fixed(v) || m.vt[v as usize].is_empty() {
         return false;
@@ -298,25 +301,26 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
     let p0 = m.pts[v as usize];
     let (mut best, mut bq) = (p0, q0);
     let mut scale = min_len;
-    const RINGS: usize = 10;
-    const PER_RING: usize = 96;
-    // Directions from a spherical Fibonacci lattice, radii cycling through (0, 1].
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut ring = Vec::with_capacity(PER_RING);
     for _ in 0..RINGS {
         let centre = best;
-        for i in 0..PER_RING {
-            let z = 1.0 - (2 * i + 1) as f64 / PER_RING as f64;
-            let r = (1.0 - z * z).sqrt();
-            let phi = golden * i as f64;
-            let len = scale * [1.0, 0.66, 0.33][i % 3];
-            let p = [
-                centre[0] + len * r * phi.cos(),
-                centre[1] + len * r * phi.sin(),
-                centre[2] + len * z,
-            ];
-            let q = star_min(m, v, &s.star, p, bq, &mut s.qs, &mut s.hint);
+        // The ring's trials at once (on the pool's threads), each against the best
+        // quality before the ring; then in order, each kept if it beats the best so far.
+        // The same choice as trying them one by one against the best so far: a trial
+        // above that is above the ring's floor too, so its minimum is exact either way.
+        let floor = bq;
+        let star = &s.star;
+        (0..PER_RING)
+            .into_par_iter()
+            .with_min_len(PER_RING / 4)
+            .map_init(
+                || (Vec::new(), usize::MAX),
+                |(qs, hint), i| star_min(m, v, star, ring_trial(centre, scale, i), floor, qs, hint),
+            )
+            .collect_into_vec(&mut ring);
+        for (i, &q) in ring.iter().enumerate() {
             if q > bq {
-                best = p;
+                best = ring_trial(centre, scale, i);
                 bq = q;
             }
         }
@@ -336,6 +340,27 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
     );
     place(m, v, best, s);
     true
+}
+
+/// Rings of trial points of [`search_vertex`], each half the radius of the one before.
+const RINGS: usize = 10;
+
+/// Trial points per ring of [`search_vertex`].
+const PER_RING: usize = 96;
+
+/// Trial point `i` of [`search_vertex`]'s ring of radius `scale` around `centre`:
+/// directions from a spherical Fibonacci lattice, radii cycling through (0, 1] of it.
+fn ring_trial(centre: P3, scale: f64, i: usize) -> P3 {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let z = 1.0 - (2 * i + 1) as f64 / PER_RING as f64;
+    let r = (1.0 - z * z).sqrt();
+    let phi = golden * i as f64;
+    let len = scale * [1.0, 0.66, 0.33][i % 3];
+    [
+        centre[0] + len * r * phi.cos(),
+        centre[1] + len * r * phi.sin(),
+        centre[2] + len * z,
+    ]
 }
 
 /// Move `v` to `p`, with `s.qs` holding the qualities of its star (`s.star`) there.
@@ -403,6 +428,50 @@ mod tests {
             above > 100 && below > 100 && first > 10,
             "{above} {below} {first}"
         );
+    }
+
+    /// A search's parallel rings choose the point that trying every trial in turn
+    /// against the best so far chooses, with one thread or several.
+    #[test]
+    fn a_search_chooses_as_one_trial_at_a_time() {
+        use crate::optimize::linear::{mesh::LinMesh, ElementQuality};
+        let c = crate::optimize::testmesh::cube(3, 0.08);
+        let bnd = c.boundary();
+        let pts = crate::optimize::testmesh::jittered(&c, 9, 0.2);
+        let m = LinMesh::new(pts, c.tets.clone(), &bnd, ElementQuality);
+        let pools = [1, 3].map(|n| crate::threads::pool(n, false).unwrap());
+        let mut moved = 0;
+        for v in (0..m.pts.len() as u32).filter(|&v| !bnd.is_fixed(v)) {
+            // One trial at a time.
+            let mut s = SmoothScratch::default();
+            let (len, q0) = load_star(&m, v, &mut s);
+            let (mut best, mut bq, mut scale) = (m.pts[v as usize], q0, len);
+            for _ in 0..RINGS {
+                let centre = best;
+                for i in 0..PER_RING {
+                    let p = ring_trial(centre, scale, i);
+                    let q = star_min(&m, v, &s.star, p, bq, &mut s.qs, &mut s.hint);
+                    if q > bq {
+                        (best, bq) = (p, q);
+                    }
+                }
+                scale *= 0.5;
+            }
+            let want = if bq > q0 + 1e-9 {
+                best
+            } else {
+                m.pts[v as usize]
+            };
+            for pool in &pools {
+                let mut mv = m.clone();
+                let mut s = SmoothScratch::default();
+                let did = pool.install(|| search_vertex(&mut mv, v, &mut s));
+                assert_eq!(did, bq > q0 + 1e-9);
+                assert_eq!(mv.pts[v as usize], want, "vertex {v}");
+                moved += usize::from(did);
+            }
+        }
+        assert!(moved >= 8, "{moved}");
     }
 
     #[test]
