@@ -45,8 +45,22 @@ pub(super) struct SmoothScratch {
     star: Vec<u32>,
     grads: Vec<[f64; 3]>,
     qs: Vec<f64>,
+    /// Per tet of `star`: its corners, with their positions but `v`'s (which the trials
+    /// replace), read once per smoothing rather than at every trial point.
+    corners: Vec<StarTet>,
     /// [`star_min`]'s hint into `star`.
     hint: usize,
+}
+
+/// A tet of the star of the vertex being smoothed ([`SmoothScratch::corners`]).
+#[derive(Clone, Copy)]
+struct StarTet {
+    /// Its corners.
+    tv: [u32; 4],
+    /// Their positions (the vertex's at `k` is replaced by the trial point).
+    c: [P3; 4],
+    /// The vertex's corner.
+    k: usize,
 }
 
 /// Minimum-norm point of the convex hull of `g` (Gilbert's algorithm; few points).
@@ -90,17 +104,19 @@ fn min_norm_point(g: &[[f64; 3]]) -> [f64; 3] {
 /// only the value below `floor`, never the result above it.
 fn star_min(
     m: &LinMesh,
-    v: u32,
     star: &[u32],
+    corners: &[StarTet],
     p: P3,
     floor: f64,
     qs: &mut Vec<f64>,
     hint: &mut usize,
 ) -> f64 {
-    // The quality of star tet `t` at `p`, or None when it stops the call.
-    let eval = |t: u32| -> Result<f64, f64> {
-        let tv = m.tets[t as usize];
-        let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
+    // The quality of star tet `i` at `p`: Err when it stops the call.
+    let eval = |i: usize| -> Result<f64, f64> {
+        let (t, st) = (star[i], &corners[i]);
+        let tv = st.tv;
+        let mut c = st.c;
+        c[st.k] = p;
         if m.exempt(t) {
             let q = m.quality_at(tv, &c);
             return if q < m.q[t as usize] {
@@ -117,18 +133,19 @@ fn star_min(
         }
     };
     qs.clear();
-    let first = match star.get(*hint) {
-        Some(&t) => match eval(t) {
+    let first = if *hint < star.len() {
+        match eval(*hint) {
             Err(q) => return q,
             Ok(q) => Some(q),
-        },
-        None => None,
+        }
+    } else {
+        None
     };
     let mut lo = f64::INFINITY;
     for (i, &t) in star.iter().enumerate() {
         let q = match first {
             Some(q) if i == *hint => Ok(q),
-            _ => eval(t),
+            _ => eval(i),
         };
         match q {
             Ok(q) => {
@@ -155,6 +172,15 @@ fn load_star(m: &LinMesh, v: u32, s: &mut SmoothScratch) -> (f64, f64) {
     s.star.extend_from_slice(&m.vt[v as usize]);
     s.star
         .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
+    s.corners.clear();
+    s.corners.extend(s.star.iter().map(|&t| {
+        let tv = m.tets[t as usize];
+        StarTet {
+            tv,
+            c: tv.map(|x| m.pts[x as usize]),
+            k: tv.iter().position(|&x| x == v).unwrap_or(0),
+        }
+    }));
     let p = m.pts[v as usize];
     // (sqrt is monotone and correctly rounded: the root of the least square is the least
     // distance.)
@@ -266,7 +292,15 @@ pub(super) fn smooth_vertex(
                 p[1] + alpha * d[1],
                 p[2] + alpha * d[2],
             ];
-            let nq = star_min(m, v, &s.star, np, qmin + prm.eps, &mut s.qs, &mut s.hint);
+            let nq = star_min(
+                m,
+                &s.star,
+                &s.corners,
+                np,
+                qmin + prm.eps,
+                &mut s.qs,
+                &mut s.hint,
+            );
             if nq > qmin + prm.eps {
                 last_step = alpha * dn;
                 p = np;
@@ -309,13 +343,23 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
         // The same choice as trying them one by one against the best so far: a trial
         // above that is above the ring's floor too, so its minimum is exact either way.
         let floor = bq;
-        let star = &s.star;
+        let (star, corners) = (&s.star, &s.corners);
         (0..PER_RING)
             .into_par_iter()
             .with_min_len(PER_RING / 4)
             .map_init(
                 || (Vec::new(), usize::MAX),
-                |(qs, hint), i| star_min(m, v, star, ring_trial(centre, scale, i), floor, qs, hint),
+                |(qs, hint), i| {
+                    star_min(
+                        m,
+                        star,
+                        corners,
+                        ring_trial(centre, scale, i),
+                        floor,
+                        qs,
+                        hint,
+                    )
+                },
             )
             .collect_into_vec(&mut ring);
         for (i, &q) in ring.iter().enumerate() {
@@ -331,8 +375,8 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
     }
     star_min(
         m,
-        v,
         &s.star,
+        &s.corners,
         best,
         f64::NEG_INFINITY,
         &mut s.qs,
@@ -376,8 +420,9 @@ fn place(m: &mut LinMesh, v: u32, p: P3, s: &SmoothScratch) {
 mod tests {
     use super::*;
 
-    /// Whatever the hint, a trial point above the floor gets the same minimum and the
-    /// same star qualities, bit for bit; below it the call says so and leaves as hint
+    /// A trial point above the floor gets its star's qualities as the mesh scores them
+    /// and their minimum; whatever the hint, the same, bit for bit. Below the floor the
+    /// call says so and leaves as hint
     /// the tet that stopped it, which stops the next call at once.
     #[test]
     fn the_hint_changes_which_tet_stops_a_trial_only() {
@@ -392,13 +437,28 @@ mod tests {
         let (mut above, mut below, mut first) = (0, 0, 0);
         for v in (0..m.pts.len() as u32).filter(|&v| !bnd.is_fixed(v)) {
             let (len, q0) = load_star(&m, v, &mut s);
-            let star = s.star.clone();
+            let (star, corners) = (s.star.clone(), s.corners.clone());
             for _ in 0..200 {
                 let p = m.pts[v as usize].map(|x| x + rng.random_range(-0.3..0.3) * len);
                 let floor = q0 + rng.random_range(-0.2..0.05);
                 let mut none = usize::MAX;
                 let mut plain = Vec::new();
-                let want = star_min(&m, v, &star, p, floor, &mut plain, &mut none);
+                let want = star_min(&m, &star, &corners, p, floor, &mut plain, &mut none);
+                if want > floor {
+                    // The star's qualities with `v` at `p`, from the mesh itself.
+                    let direct: Vec<f64> = star
+                        .iter()
+                        .map(|&t| {
+                            let tv = m.tets[t as usize];
+                            m.quality_at(
+                                tv,
+                                &tv.map(|x| if x == v { p } else { m.pts[x as usize] }),
+                            )
+                        })
+                        .collect();
+                    assert_eq!(plain, direct);
+                    assert_eq!(want, direct.iter().copied().fold(f64::INFINITY, f64::min));
+                }
                 for hint in [
                     usize::MAX,
                     0,
@@ -406,7 +466,7 @@ mod tests {
                     rng.random_range(0..star.len()),
                 ] {
                     let (mut h, mut qs) = (hint, Vec::new());
-                    let got = star_min(&m, v, &star, p, floor, &mut qs, &mut h);
+                    let got = star_min(&m, &star, &corners, p, floor, &mut qs, &mut h);
                     assert_eq!(got > floor, want > floor);
                     if want > floor {
                         assert_eq!(got.to_bits(), want.to_bits());
@@ -417,7 +477,7 @@ mod tests {
                         below += 1;
                         // The stopping tet is the hint now: the same trial stops at it.
                         let mut again = Vec::new();
-                        let q = star_min(&m, v, &star, p, floor, &mut again, &mut h);
+                        let q = star_min(&m, &star, &corners, p, floor, &mut again, &mut h);
                         assert!(q <= floor && again.is_empty(), "{q} {again:?}");
                         first += usize::from(h != hint);
                     }
@@ -450,7 +510,7 @@ mod tests {
                 let centre = best;
                 for i in 0..PER_RING {
                     let p = ring_trial(centre, scale, i);
-                    let q = star_min(&m, v, &s.star, p, bq, &mut s.qs, &mut s.hint);
+                    let q = star_min(&m, &s.star, &s.corners, p, bq, &mut s.qs, &mut s.hint);
                     if q > bq {
                         (best, bq) = (p, q);
                     }
