@@ -116,8 +116,9 @@ pub struct FillTry {
     pub steiner_removal_seconds: f64,
     /// Steiner points edge and face recovery added (all on the surface until moved).
     pub steiner_points: usize,
-    /// Placing the interior points (the octree, its clearance from the surface and the
-    /// inside test), once for all the tries: on the first try, 0 on the others.
+    /// Placing the interior points (the octree, the inside test and the clearance from
+    /// the surface): on the first try, for the points inside, and again on the first
+    /// try with the points outside too ([`FillTry::points_outside`]); 0 on the others.
     pub points_seconds: f64,
     /// After the Steiner points moved: contracting flat tets and slivers, lifting points
     /// above thin tets on the surface, and collecting the tets (0 where the try stopped

@@ -49,9 +49,9 @@ pub(crate) fn whole_fill(
     let FillInput {
         corners,
         pts,
-        interior,
+        mut interior,
         faces,
-    } = fill_input(surf_nodes, surf_tris, size)?;
+    } = fill_input(surf_nodes, surf_tris, size, false)?;
     // (On the first try's report.)
     let mut placed = clock.elapsed().as_secs_f64();
     let n_corners = pts.len();
@@ -65,6 +65,14 @@ pub(crate) fn whole_fill(
     let mut filled = None;
     let mut tries = Vec::new();
     'fills: for with_outside in [false, true] {
+        if with_outside {
+            // The candidates again, those outside kept too (the first try's have only
+            // those inside: clearing the others, most of the octree's, took most of
+            // the points' time). The same input, so the same corners and faces.
+            let clock = std::time::Instant::now();
+            interior = fill_input(surf_nodes, surf_tris, size, true)?.interior;
+            placed += clock.elapsed().as_secs_f64();
+        }
         let mut all = pts.clone();
         all.extend(
             interior
@@ -167,7 +175,8 @@ struct FillInput {
     corners: Vec<u32>,
     /// The corners' points, in local numbering.
     pts: Vec<P3>,
-    /// The interior candidates, each with whether the surface encloses it.
+    /// The interior candidates, each with whether the surface encloses it (those it
+    /// does not only when asked: see [`interior_points`]).
     interior: Vec<(P3, bool)>,
     /// The corner triangles in local numbering, reversed: the fill wants the region on
     /// each face's positive side.
@@ -178,13 +187,14 @@ fn fill_input(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
     size: &SizeField,
+    outside: bool,
 ) -> Result<FillInput, String> {
     let mut corners: Vec<u32> = surf_tris.iter().flat_map(|t| [t[0], t[1], t[2]]).collect();
     corners.sort_unstable();
     corners.dedup();
     let local = |v: u32| corners.binary_search(&v).map_or(u32::MAX, |i| i as u32);
     let pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
-    let interior = interior_points(&pts, surf_tris, &local, size)?;
+    let interior = interior_points(&pts, surf_tris, &local, size, outside)?;
     let faces: Vec<[u32; 3]> = surf_tris
         .iter()
         .map(|t| [local(t[0]), local(t[2]), local(t[1])])
@@ -200,12 +210,14 @@ fn fill_input(
 /// Octree leaf centres and corners in the surface's box, at least [`CLEARANCE`] sizes
 /// from every triangle, in depth-first (Morton) order, so that consecutive points are
 /// near each other for the Delaunay insertion's walk; each with whether the surface
-/// encloses it.
+/// encloses it. Those it does not enclose only when `outside` asks: the octree covers
+/// the surface's box, and on thin CAD parts nearly all its points are outside.
 fn interior_points(
     corner_pts: &[P3],
     surf_tris: &[[u32; 6]],
     local: &dyn Fn(u32) -> u32,
     size: &SizeField,
+    outside: bool,
 ) -> Result<Vec<(P3, bool)>, String> {
     let bounds = Aabb::of(corner_pts);
     let ext = (0..3)
@@ -294,9 +306,18 @@ fn interior_points(
             ));
         }
     }
+    // Which are inside, first: those outside cost the Delaunay insertion and the
+    // boundary recovery their tets, then are dropped with them, and are cleared only
+    // when asked for.
+    let positions: Vec<P3> = cand.iter().map(|&(p, _)| p).collect();
+    let inside = crate::surface::inside::enclosed(&tris, &positions);
+    drop(positions);
     let mut near = Vec::new();
-    let mut keep = Vec::with_capacity(cand.len());
-    for (p, known) in cand {
+    let mut keep = Vec::new();
+    for ((p, known), inside) in cand.into_iter().zip(inside) {
+        if !inside && !outside {
+            continue;
+        }
         let h = known.unwrap_or_else(|floor| size.at_near(p, floor).0);
         let r = CLEARANCE * h;
         let b = Aabb {
@@ -312,13 +333,10 @@ fn interior_points(
                 && balls[i as usize].iter().all(|&(c, r2)| dist2(p, c) >= r2)
         });
         if clear {
-            keep.push(p);
+            keep.push((p, inside));
         }
     }
-    // Which are inside: those outside cost the Delaunay insertion and the boundary
-    // recovery their tets, then are dropped with them.
-    let inside = crate::surface::inside::enclosed(&tris, &keep);
-    Ok(keep.into_iter().zip(inside).collect())
+    Ok(keep)
 }
 
 /// The balls an interior point must stay out of for a surface triangle's edges and the
@@ -455,7 +473,7 @@ mod tests {
             .join(format!("tests/data/openscad/{name}.stl"));
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
-        let inp = fill_input(s.nodes(), s.triangles(), &size).unwrap();
+        let inp = fill_input(s.nodes(), s.triangles(), &size, outside).unwrap();
         let mut all = inp.pts.clone();
         all.extend(inp.interior.iter().filter(|p| p.1 || outside).map(|p| p.0));
         let mut stages = cdt_fill::Stages::default();
@@ -524,14 +542,18 @@ mod tests {
     }
 
     /// The torus (R = 1, r = 0.35, axis z): the candidates inside the tube are marked
-    /// inside, those in the hole and the box's corners outside, and there are both.
+    /// inside, those in the hole and the box's corners outside, and there are both;
+    /// without those outside, the same points inside in the same order.
     #[test]
     fn interior_points_know_whether_the_surface_encloses_them() {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/torus_p2.msh");
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
         let id = |v: u32| v;
-        let pts = interior_points(s.nodes(), s.triangles(), &id, &size).unwrap();
+        let pts = interior_points(s.nodes(), s.triangles(), &id, &size, true).unwrap();
+        let only_inside = interior_points(s.nodes(), s.triangles(), &id, &size, false).unwrap();
+        let want: Vec<(P3, bool)> = pts.iter().copied().filter(|p| p.1).collect();
+        assert_eq!(only_inside, want);
         let inside = pts.iter().filter(|p| p.1).count();
         assert!(
             inside > 10 && inside < pts.len(),
