@@ -420,17 +420,27 @@ fn place(m: &mut LinMesh, v: u32, p: P3, s: &SmoothScratch) {
 mod tests {
     use super::*;
 
-    /// A trial point above the floor gets its star's qualities as the mesh scores them
-    /// and their minimum; whatever the hint, the same, bit for bit. Below the floor the
-    /// call says so and leaves as hint
-    /// the tet that stopped it, which stops the next call at once.
-    #[test]
-    fn the_hint_changes_which_tet_stops_a_trial_only() {
-        use crate::optimize::linear::{mesh::LinMesh, ElementQuality};
-        use rand::{Rng, SeedableRng};
+    use crate::optimize::linear::{mesh::LinMesh, ElementQuality};
+    use crate::optimize::testmesh::CubeMesh;
+    use crate::optimize::Boundary;
+
+    /// The bulged 3 x 3 x 3 cube test mesh, its boundary, and its points with the
+    /// interior ones moved at random by up to `amp` (seed `seed`).
+    fn jittered_cube(seed: u64, amp: f64) -> (CubeMesh, Boundary, Vec<P3>) {
         let c = crate::optimize::testmesh::cube(3, 0.08);
         let bnd = c.boundary();
-        let pts = crate::optimize::testmesh::jittered(&c, 5, 0.1);
+        let pts = crate::optimize::testmesh::jittered(&c, seed, amp);
+        (c, bnd, pts)
+    }
+
+    /// A trial point above the floor gets its star's qualities as the mesh scores them
+    /// and their minimum; whatever the hint, the same, bit for bit. Below the floor the
+    /// call says so and leaves as hint the tet that stopped it, which stops the next call
+    /// at once.
+    #[test]
+    fn the_hint_changes_which_tet_stops_a_trial_only() {
+        use rand::{Rng, SeedableRng};
+        let (c, bnd, pts) = jittered_cube(5, 0.1);
         let m = LinMesh::new(pts, c.tets.clone(), &bnd, ElementQuality);
         let mut rng = rand::rngs::StdRng::seed_from_u64(3);
         let mut s = SmoothScratch::default();
@@ -494,10 +504,7 @@ mod tests {
     /// against the best so far chooses, with one thread or several.
     #[test]
     fn a_search_chooses_as_one_trial_at_a_time() {
-        use crate::optimize::linear::{mesh::LinMesh, ElementQuality};
-        let c = crate::optimize::testmesh::cube(3, 0.08);
-        let bnd = c.boundary();
-        let pts = crate::optimize::testmesh::jittered(&c, 9, 0.2);
+        let (c, bnd, pts) = jittered_cube(9, 0.2);
         let m = LinMesh::new(pts, c.tets.clone(), &bnd, ElementQuality);
         let pools = [1, 3].map(|n| crate::threads::pool(n, false).unwrap());
         let mut moved = 0;
