@@ -37,16 +37,25 @@ pub const MIN_RELATIVE_VOLUME: f64 = 1e-12;
 /// the exact predicate, but its Jacobian cannot be certified.
 #[inline]
 pub fn numerically_flat(c: &[P3; 4]) -> bool {
-    let l2 = super::shape::TET10_EDGES
+    let (det, flat_below, _) = flatness(c);
+    det <= flat_below
+}
+
+/// The floating-point 6 x volume of the tet `c`, the [`numerically_flat`] threshold
+/// [`MIN_RELATIVE_VOLUME`] l³ it is compared with, and l² (l the longest edge).
+#[inline]
+fn flatness(c: &[P3; 4]) -> (f64, f64, f64) {
+    let l2 = TET10_EDGES
         .iter()
         .map(|&[i, j]| super::vec3::dist2(c[i], c[j]))
         .fold(0.0, f64::max);
-    super::vec3::tet_det(c[0], c[1], c[2], c[3]) <= MIN_RELATIVE_VOLUME * l2 * l2.sqrt()
+    let det = super::vec3::tet_det(c[0], c[1], c[2], c[3]);
+    (det, MIN_RELATIVE_VOLUME * l2 * l2.sqrt(), l2)
 }
 
 /// Whether the straight tet `c` is positive (exact [`orient3d`](super::predicates::orient3d))
-/// and not [`numerically_flat`], mostly without the exact predicate: the linear stage
-/// asks this of every tet it scores, and the predicate took a sixth of that.
+/// and not [`numerically_flat`], mostly without the exact predicate (the linear stage
+/// asks this of every tet it scores).
 ///
 /// Why f64 decides it: a tet that is not numerically flat has a floating-point
 /// determinant above [`MIN_RELATIVE_VOLUME`] l³ (l its longest edge), while that
@@ -57,12 +66,8 @@ pub fn numerically_flat(c: &[P3; 4]) -> bool {
 /// could underflow or overflow, or NaN), the predicate decides as before.
 #[inline]
 pub fn positive_and_not_flat(c: &[P3; 4]) -> bool {
-    let l2 = TET10_EDGES
-        .iter()
-        .map(|&[i, j]| super::vec3::dist2(c[i], c[j]))
-        .fold(0.0, f64::max);
-    let det = super::vec3::tet_det(c[0], c[1], c[2], c[3]);
-    let not_flat = det > MIN_RELATIVE_VOLUME * l2 * l2.sqrt();
+    let (det, flat_below, l2) = flatness(c);
+    let not_flat = det > flat_below;
     if (1e-140..=1e140).contains(&l2) {
         return not_flat;
     }
@@ -496,6 +501,8 @@ mod tests {
     use super::super::shape::{straight_tet10, tet10_det_jacobian};
     use super::super::testutil::{lattice, random_corners, random_curved};
     use super::*;
+    use rand::rngs::StdRng;
+    use rand::SeedableRng;
 
     /// `positive_and_not_flat` is exactly "positive by the exact predicate and not
     /// numerically flat": on random tets, on tets flattened towards and past the
@@ -503,8 +510,8 @@ mod tests {
     #[test]
     fn positive_and_not_flat_is_the_predicate_and_the_flatness_test() {
         use crate::geom::predicates::orient3d;
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+        use rand::Rng;
+        let mut rng = StdRng::seed_from_u64(17);
         let (mut yes, mut flat, mut neg) = (0, 0, 0);
         for i in 0..200_000 {
             let unit = [1.0, 1e-3, 1e5, 1e-80, 1e80][i % 5];
@@ -536,9 +543,6 @@ mod tests {
             "{yes} {flat} {neg}"
         );
     }
-
-    use rand::rngs::StdRng;
-    use rand::SeedableRng;
 
     #[test]
     fn theta_e_is_acos_one_third() {

@@ -42,25 +42,37 @@ const SLIVER_HALVINGS: usize = 20;
 /// Scratch buffers of the smoother.
 #[derive(Default)]
 pub(super) struct SmoothScratch {
-    star: Vec<u32>,
+    /// The star of the vertex being smoothed or searched ([`load_star`]).
+    star: Vec<StarTet>,
     grads: Vec<[f64; 3]>,
     qs: Vec<f64>,
-    /// Per tet of `star`: its corners, with their positions but `v`'s (which the trials
-    /// replace), read once per smoothing rather than at every trial point.
-    corners: Vec<StarTet>,
     /// [`star_min`]'s hint into `star`.
     hint: usize,
 }
 
-/// A tet of the star of the vertex being smoothed ([`SmoothScratch::corners`]).
+/// A tet of the star of the vertex being smoothed, with its corner positions read once
+/// per smoothing rather than at every trial point (the other corners do not move
+/// meanwhile).
 #[derive(Clone, Copy)]
 struct StarTet {
+    /// The tet.
+    t: u32,
     /// Its corners.
     tv: [u32; 4],
     /// Their positions (the vertex's at `k` is replaced by the trial point).
     c: [P3; 4],
     /// The vertex's corner.
     k: usize,
+}
+
+impl StarTet {
+    /// The corner positions with the vertex at `p`.
+    #[inline]
+    fn at(&self, p: P3) -> [P3; 4] {
+        let mut c = self.c;
+        c[self.k] = p;
+        c
+    }
 }
 
 /// Minimum-norm point of the convex hull of `g` (Gilbert's algorithm; few points).
@@ -99,13 +111,11 @@ fn min_norm_point(g: &[[f64; 3]]) -> [f64; 3] {
 ///
 /// `hint`: the star index of the tet that stopped the last call early (`usize::MAX`:
 /// none), tried first. Consecutive trial points of a search or a line search lie near
-/// each other, and the tet that rejected one mostly rejects the next: on OpenSCAD's CSG
-/// a rejected trial took 2.2 evaluations in star order. Which tet stops a call changes
-/// only the value below `floor`, never the result above it.
+/// each other, and the tet that rejected one mostly rejects the next. Which tet stops a
+/// call changes only the value below `floor`, never the result above it.
 fn star_min(
     m: &LinMesh,
-    star: &[u32],
-    corners: &[StarTet],
+    star: &[StarTet],
     p: P3,
     floor: f64,
     qs: &mut Vec<f64>,
@@ -113,10 +123,8 @@ fn star_min(
 ) -> f64 {
     // The quality of star tet `i` at `p`: Err when it stops the call.
     let eval = |i: usize| -> Result<f64, f64> {
-        let (t, st) = (star[i], &corners[i]);
-        let tv = st.tv;
-        let mut c = st.c;
-        c[st.k] = p;
+        let StarTet { t, tv, .. } = star[i];
+        let c = star[i].at(p);
         if m.exempt(t) {
             let q = m.quality_at(tv, &c);
             return if q < m.q[t as usize] {
@@ -142,7 +150,7 @@ fn star_min(
         None
     };
     let mut lo = f64::INFINITY;
-    for (i, &t) in star.iter().enumerate() {
+    for (i, st) in star.iter().enumerate() {
         let q = match first {
             Some(q) if i == *hint => Ok(q),
             _ => eval(i),
@@ -150,7 +158,7 @@ fn star_min(
         match q {
             Ok(q) => {
                 qs.push(q);
-                if !m.exempt(t) {
+                if !m.exempt(st.t) {
                     lo = lo.min(q);
                 }
             }
@@ -167,28 +175,30 @@ fn star_min(
 /// is rejected after few evaluations); returns the shortest edge at `v` and the star's
 /// minimum quality.
 fn load_star(m: &LinMesh, v: u32, s: &mut SmoothScratch) -> (f64, f64) {
-    s.star.clear();
     s.hint = usize::MAX;
-    s.star.extend_from_slice(&m.vt[v as usize]);
-    s.star
-        .sort_by(|&a, &b| m.q[a as usize].total_cmp(&m.q[b as usize]).then(a.cmp(&b)));
-    s.corners.clear();
-    s.corners.extend(s.star.iter().map(|&t| {
+    s.star.clear();
+    s.star.extend(m.vt[v as usize].iter().map(|&t| {
         let tv = m.tets[t as usize];
         StarTet {
+            t,
             tv,
             c: tv.map(|x| m.pts[x as usize]),
             k: tv.iter().position(|&x| x == v).unwrap_or(0),
         }
     }));
+    s.star.sort_by(|a, b| {
+        m.q[a.t as usize]
+            .total_cmp(&m.q[b.t as usize])
+            .then(a.t.cmp(&b.t))
+    });
     let p = m.pts[v as usize];
     // (sqrt is monotone and correctly rounded: the root of the least square is the least
     // distance.)
     let mut min_len2 = f64::INFINITY;
-    for &t in &s.star {
-        for &x in &m.tets[t as usize] {
-            if x != v {
-                min_len2 = min_len2.min(dist2(p, m.pts[x as usize]));
+    for st in &s.star {
+        for (i, &x) in st.c.iter().enumerate() {
+            if i != st.k {
+                min_len2 = min_len2.min(dist2(p, x));
             }
         }
     }
@@ -196,8 +206,8 @@ fn load_star(m: &LinMesh, v: u32, s: &mut SmoothScratch) -> (f64, f64) {
     let qmin = s
         .star
         .iter()
-        .filter(|&&t| !m.exempt(t))
-        .map(|&t| m.q[t as usize])
+        .filter(|st| !m.exempt(st.t))
+        .map(|st| m.q[st.t as usize])
         .fold(f64::INFINITY, f64::min);
     (min_len, qmin)
 }
@@ -235,15 +245,14 @@ pub(super) fn smooth_vertex(
         };
         // Active pieces and their gradients.
         s.grads.clear();
-        for &t in &s.star {
+        for st in &s.star {
+            let StarTet { t, tv, k, .. } = *st;
             let qt = m.q[t as usize];
             if qt > qmin + active_tol || m.exempt(t) {
                 // Far from active: only its first-order behaviour matters for the step.
                 continue;
             }
-            let tv = m.tets[t as usize];
-            let k = tv.iter().position(|&x| x == v).unwrap_or(0);
-            let c = tv.map(|x| if x == v { p } else { m.pts[x as usize] });
+            let c = st.at(p);
             if qt < 0.0 {
                 // P2-invalid (curved) tet: finite-difference gradient of its score.
                 let h = 1e-6 * min_len;
@@ -292,15 +301,7 @@ pub(super) fn smooth_vertex(
                 p[1] + alpha * d[1],
                 p[2] + alpha * d[2],
             ];
-            let nq = star_min(
-                m,
-                &s.star,
-                &s.corners,
-                np,
-                qmin + prm.eps,
-                &mut s.qs,
-                &mut s.hint,
-            );
+            let nq = star_min(m, &s.star, np, qmin + prm.eps, &mut s.qs, &mut s.hint);
             if nq > qmin + prm.eps {
                 last_step = alpha * dn;
                 p = np;
@@ -343,23 +344,13 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
         // The same choice as trying them one by one against the best so far: a trial
         // above that is above the ring's floor too, so its minimum is exact either way.
         let floor = bq;
-        let (star, corners) = (&s.star, &s.corners);
+        let star = &s.star;
         (0..PER_RING)
             .into_par_iter()
             .with_min_len(PER_RING / 4)
             .map_init(
                 || (Vec::new(), usize::MAX),
-                |(qs, hint), i| {
-                    star_min(
-                        m,
-                        star,
-                        corners,
-                        ring_trial(centre, scale, i),
-                        floor,
-                        qs,
-                        hint,
-                    )
-                },
+                |(qs, hint), i| star_min(m, star, ring_trial(centre, scale, i), floor, qs, hint),
             )
             .collect_into_vec(&mut ring);
         for (i, &q) in ring.iter().enumerate() {
@@ -373,15 +364,7 @@ pub(super) fn search_vertex(m: &mut LinMesh, v: u32, s: &mut SmoothScratch) -> b
     if bq <= q0 + 1e-9 {
         return false;
     }
-    star_min(
-        m,
-        &s.star,
-        &s.corners,
-        best,
-        f64::NEG_INFINITY,
-        &mut s.qs,
-        &mut s.hint,
-    );
+    star_min(m, &s.star, best, f64::NEG_INFINITY, &mut s.qs, &mut s.hint);
     place(m, v, best, s);
     true
 }
@@ -411,8 +394,8 @@ fn ring_trial(centre: P3, scale: f64, i: usize) -> P3 {
 fn place(m: &mut LinMesh, v: u32, p: P3, s: &SmoothScratch) {
     m.pts[v as usize] = p;
     m.touch_star(v);
-    for (&t, &q) in s.star.iter().zip(&s.qs) {
-        m.q[t as usize] = q;
+    for (st, &q) in s.star.iter().zip(&s.qs) {
+        m.q[st.t as usize] = q;
     }
 }
 
@@ -447,19 +430,19 @@ mod tests {
         let (mut above, mut below, mut first) = (0, 0, 0);
         for v in (0..m.pts.len() as u32).filter(|&v| !bnd.is_fixed(v)) {
             let (len, q0) = load_star(&m, v, &mut s);
-            let (star, corners) = (s.star.clone(), s.corners.clone());
+            let star = s.star.clone();
             for _ in 0..200 {
                 let p = m.pts[v as usize].map(|x| x + rng.random_range(-0.3..0.3) * len);
                 let floor = q0 + rng.random_range(-0.2..0.05);
                 let mut none = usize::MAX;
                 let mut plain = Vec::new();
-                let want = star_min(&m, &star, &corners, p, floor, &mut plain, &mut none);
+                let want = star_min(&m, &star, p, floor, &mut plain, &mut none);
                 if want > floor {
                     // The star's qualities with `v` at `p`, from the mesh itself.
                     let direct: Vec<f64> = star
                         .iter()
-                        .map(|&t| {
-                            let tv = m.tets[t as usize];
+                        .map(|st| {
+                            let tv = m.tets[st.t as usize];
                             m.quality_at(
                                 tv,
                                 &tv.map(|x| if x == v { p } else { m.pts[x as usize] }),
@@ -476,7 +459,7 @@ mod tests {
                     rng.random_range(0..star.len()),
                 ] {
                     let (mut h, mut qs) = (hint, Vec::new());
-                    let got = star_min(&m, &star, &corners, p, floor, &mut qs, &mut h);
+                    let got = star_min(&m, &star, p, floor, &mut qs, &mut h);
                     assert_eq!(got > floor, want > floor);
                     if want > floor {
                         assert_eq!(got.to_bits(), want.to_bits());
@@ -487,7 +470,7 @@ mod tests {
                         below += 1;
                         // The stopping tet is the hint now: the same trial stops at it.
                         let mut again = Vec::new();
-                        let q = star_min(&m, &star, &corners, p, floor, &mut again, &mut h);
+                        let q = star_min(&m, &star, p, floor, &mut again, &mut h);
                         assert!(q <= floor && again.is_empty(), "{q} {again:?}");
                         first += usize::from(h != hint);
                     }
@@ -517,7 +500,7 @@ mod tests {
                 let centre = best;
                 for i in 0..PER_RING {
                     let p = ring_trial(centre, scale, i);
-                    let q = star_min(&m, &s.star, &s.corners, p, bq, &mut s.qs, &mut s.hint);
+                    let q = star_min(&m, &s.star, p, bq, &mut s.qs, &mut s.hint);
                     if q > bq {
                         (best, bq) = (p, q);
                     }
