@@ -78,7 +78,7 @@ pub use io::{
 pub use mesh::report::QualityReport;
 pub use mesh::slivers::SliverCensus;
 pub use mesh::TetMesh;
-pub use optimize::{HighOrderStats, LinearStats, OptimizeStats};
+pub use optimize::{HighOrderStats, LinearSeconds, LinearStats, OptimizeStats};
 pub use options::{Options, SizeFrom, SizeMode};
 pub use regions::{
     generate_input, generate_regions, MeshInput, Region, RegionMode, RegionResult, Regions,

@@ -23,7 +23,7 @@ pub(crate) mod testmesh;
 
 pub use boundary::Boundary;
 pub use high_order::{optimize_high_order, HighOrderParams, HighOrderStats, RoundTuning};
-pub use linear::{improve_linear, improve_linear_known, LinearParams, LinearStats};
+pub use linear::{improve_linear, improve_linear_known, LinearParams, LinearSeconds, LinearStats};
 
 /// What the optimization stages did (part of [`crate::Generated`]).
 #[derive(Debug, Clone, Default, serde::Serialize)]

@@ -170,6 +170,24 @@ pub struct LinearStats {
     /// Passes aimed at the tets within [`LinearParams::reach`] of the worst only (the
     /// goal was out of reach).
     pub reach_passes: usize,
+    /// Where the stage's time went.
+    pub seconds: LinearSeconds,
+}
+
+/// Wall-clock seconds of each part of the linear stage, in the order they run (see the
+/// module docs), so that a report shows which part a slow mesh spends its time in.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+#[non_exhaustive]
+pub struct LinearSeconds {
+    /// The first passes, aimed at [`LinearParams::goal_skewness`].
+    pub passes: f64,
+    /// The sampled vertex searches and the passes after each, aimed at
+    /// [`LinearParams::search_skewness`].
+    pub searches: f64,
+    /// The passes aimed at nearly flat tets ([`LinearParams::flat_skewness`]).
+    pub flat: f64,
+    /// The rounds aimed at the unforced slivers ([`LinearParams::sliver_passes`]).
+    pub slivers: f64,
 }
 
 /// Worst quality and the count of tets below `goal`.
@@ -241,7 +259,16 @@ pub fn improve_linear_known(
     // Clock at which each tet slot last resisted every operation (0: never); it is not
     // tried again until something in its corners' stars changes.
     let mut failed: Vec<u64> = Vec::new();
+    let mut clock = std::time::Instant::now();
+    // Seconds since the last call (or since the stage started).
+    let mut lap = || {
+        let now = std::time::Instant::now();
+        let s = now.duration_since(clock).as_secs_f64();
+        clock = now;
+        s
+    };
     run_passes(&mut m, prm, &mut sc, &mut st, &mut order, &mut failed);
+    st.seconds.passes = lap();
     // Where the passes left very poor tets: sampled vertex searches, then passes aimed at
     // the search's threshold only (aiming at the goal again costs 2-3x the first passes'
     // time on the hinge for no gain). Meshes the passes alone make good enough are not
@@ -263,6 +290,7 @@ pub fn improve_linear_known(
             &mut failed,
         );
     }
+    st.seconds.searches = lap();
     if let Some(flat) = prm.flat_skewness {
         let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
         let flat = LinearParams {
@@ -272,9 +300,11 @@ pub fn improve_linear_known(
         };
         run_passes(&mut m, &flat, &mut sc, &mut st, &mut order, &mut failed);
     }
+    st.seconds.flat = lap();
     if prm.sliver_passes > 0 {
         unforced_sliver_passes(&mut m, prm, &mut sc, &mut st, &mut order);
     }
+    st.seconds.slivers = lap();
     let (w1, b1) = census(&m, goal);
     let (pts, tets) = m.into_parts();
     st.tets[1] = tets.len();
@@ -829,6 +859,27 @@ mod tests {
             .iter()
             .zip(&pts3)
             .all(|(a, b)| a.map(f64::to_bits) == b.map(f64::to_bits)));
+    }
+
+    #[test]
+    fn the_stage_times_each_of_its_parts() {
+        let (c, pts) = shaken_cube();
+        let bnd = c.boundary();
+        // Every part runs: flat passes asked for, and a search threshold every poor tet
+        // is above.
+        let prm = LinearParams {
+            flat_skewness: Some(0.3),
+            search_skewness: 0.3,
+            ..LinearParams::default()
+        };
+        let clock = std::time::Instant::now();
+        let st = improve_linear(pts, c.tets.clone(), &bnd, &prm).2;
+        let wall = clock.elapsed().as_secs_f64();
+        let s = &st.seconds;
+        let parts = [s.passes, s.searches, s.flat, s.slivers];
+        assert!(st.passes > 0 && st.searches > 0, "{st:?}");
+        assert!(parts.iter().all(|&x| x > 0.0), "{s:?}");
+        assert!(parts.iter().sum::<f64>() <= wall, "{s:?} in {wall} s");
     }
 
     #[test]
