@@ -291,20 +291,20 @@ corpus_parts! {
     example006_meshes: "example006", 11_884, 0;
     example007_meshes: "example007", 524, 0;
     example009_meshes: "example009", 1_640, 0;
-    example010_meshes: "example010", 9_542, 25;
+    example010_meshes: "example010", 9_542, 10;
     example012_meshes: "example012", 916, 4;
     example018_meshes: "example018", 4_960, 0;
     example019_meshes: "example019", 3_912, 3;
-    example020_meshes: "example020", 8_490, 433;
+    example020_meshes: "example020", 8_490, 393;
     example021_meshes: "example021", 1_280, 12;
     example023_meshes: "example023", 3_028, 0;
     example024_meshes: "example024", 12_012, 4;
     linear_extrude_meshes: "linear_extrude", 1_690, 0;
     logo_meshes: "logo", 8_120, 3;
-    logo_and_text_meshes: "logo_and_text", 14_792, 12;
+    logo_and_text_meshes: "logo_and_text", 14_792, 6;
     projection_meshes: "projection", 1_112, 20;
     rotate_extrude_meshes: "rotate_extrude", 9_200, 0;
-    sign_meshes: "sign", 3_268, 68;
+    sign_meshes: "sign", 3_268, 33;
     surface_image_meshes: "surface_image", 6_376, 0;
     text_on_cube_meshes: "text_on_cube", 1_508, 0;
 }
