@@ -27,7 +27,8 @@ pub(super) struct InsertScratch {
     /// [`super::LinearParams::guard_slivers`]; set per pass).
     pub sliver_guard: bool,
     /// Where smoothing leaves a split's new vertex short of an improvement, search for
-    /// its position ([`search_vertex`]) before giving up (the sliver passes' last rounds).
+    /// its position ([`search_vertex`]) before giving up (the second run of the sliver
+    /// rounds, see [`super::LinearParams::sliver_passes`]).
     pub search: bool,
 }
 

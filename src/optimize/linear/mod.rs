@@ -87,7 +87,10 @@ pub struct LinearParams {
     /// the element quality, no longer block every move. Up to this many passes in all, in
     /// rounds of eight each followed by vertex searches, while a round removes some,
     /// with a budget of their own (two attempts per tet of the input); 0: none; the mesh
-    /// of the round that left the fewest is kept. The rounds keep removing them slowly
+    /// of the round that left the fewest is kept. Where some are left, the rounds run
+    /// again with edge splits that also search for their new vertex's position, from the
+    /// start and from the end, and the run that leaves the fewest is kept. The rounds
+    /// keep removing them slowly
     /// on large fills: OpenSCAD's example019 went from 14,106 to 4,352, 2,979, 2,280,
     /// 1,732, 1,415, 997, 946, 897 and 839 in ten rounds, then 845 (a cap of 40 passes
     /// stopped it at 1,415; the five rounds more took 8 s of its 63 s stage).
@@ -319,15 +322,17 @@ pub fn improve_linear_known(
 /// per tet of the input on top of what was spent. Where the rounds stall, the last ones
 /// also try [`insert_in_cavity`].
 ///
-/// The rounds run twice from the same mesh: as above, and with every edge split whose
-/// smoothed new vertex falls short searching for its position too
-/// ([`InsertScratch::search`](insert::InsertScratch)); the mesh with fewer unforced
-/// slivers is kept, the first on a tie. A split of a sliver's interior edge starts its
-/// new vertex on the sliver's nearly flat plane, where the smoother's ascent often
-/// cannot leave; the search finds a position off it (OpenSCAD's sign: 68 unforced
-/// slivers left without it, 33 with it). Run alone, the searching rounds take another
-/// path, which ends with more on some parts (GEB 15 -> 17 at this stage); run both, no
-/// part ends with more than the rounds without it leave.
+/// Where some are left, the rounds run again with every edge split whose smoothed new
+/// vertex falls short searching for its position too
+/// ([`InsertScratch::search`](insert::InsertScratch)): once from the mesh the plain
+/// rounds started from, and once from where they ended; the mesh with the fewest
+/// unforced slivers is kept, the earlier run's on a tie. A split of a sliver's interior
+/// edge starts its new vertex on the sliver's nearly flat plane, where the smoother's
+/// ascent often cannot leave; the search finds a position off it. Run alone, the
+/// searching rounds take another path, which ends with more on some parts (GEB 15 -> 17
+/// at this stage), and neither searching run is the better one everywhere (OpenSCAD's
+/// sign: 68 plain, 33 from the start, 51 from the end; example020: 433, 393, 377 in the
+/// finished mesh); with all three, no part ends with more than the plain rounds leave.
 fn unforced_sliver_passes(
     m: &mut LinMesh,
     prm: &LinearParams,
@@ -340,16 +345,29 @@ fn unforced_sliver_passes(
     }
     m.set_sliver_mode(true);
     if census(m, 1.0).1 > 0 {
-        let mut searched = m.clone();
-        let mut st_searched = st.clone();
+        let mut fresh = (m.clone(), st.clone());
         let plain = sliver_rounds(m, prm, sc, st, order);
         if plain > 0 {
             sc.insert.search = true;
-            let fewer = sliver_rounds(&mut searched, prm, sc, &mut st_searched, order);
+            // The searching runs' result with fewer than the plain run, if any (on a
+            // tie, the earlier run's).
+            let mut kept = None;
+            let f = sliver_rounds(&mut fresh.0, prm, sc, &mut fresh.1, order);
+            if f < plain {
+                kept = Some((f, fresh));
+            }
+            let fewest = kept.as_ref().map_or(plain, |k| k.0);
+            if fewest > 0 {
+                let mut chained = (m.clone(), st.clone());
+                let c = sliver_rounds(&mut chained.0, prm, sc, &mut chained.1, order);
+                if c < fewest {
+                    kept = Some((c, chained));
+                }
+            }
             sc.insert.search = false;
-            if fewer < plain {
-                *m = searched;
-                *st = st_searched;
+            if let Some((_, (mesh, stats))) = kept {
+                *m = mesh;
+                *st = stats;
             }
         }
     }
