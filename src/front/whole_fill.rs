@@ -68,9 +68,10 @@ pub(crate) fn whole_fill(
         if with_outside {
             // The candidates again, those outside kept too (the first try's have only
             // those inside: clearing the others, most of the octree's, took most of
-            // the points' time). The same input, so the same corners and faces.
+            // the points' time).
             let clock = std::time::Instant::now();
-            interior = fill_input(surf_nodes, surf_tris, size, true)?.interior;
+            let local = |v: u32| local_index(&corners, v);
+            interior = interior_points(&pts, surf_tris, &local, size, true)?;
             placed += clock.elapsed().as_secs_f64();
         }
         let mut all = pts.clone();
@@ -183,6 +184,12 @@ struct FillInput {
     faces: Vec<[u32; 3]>,
 }
 
+/// The local number of global node `v` among the sorted `corners` (`u32::MAX` if it is
+/// not one).
+fn local_index(corners: &[u32], v: u32) -> u32 {
+    corners.binary_search(&v).map_or(u32::MAX, |i| i as u32)
+}
+
 fn fill_input(
     surf_nodes: &[P3],
     surf_tris: &[[u32; 6]],
@@ -192,7 +199,7 @@ fn fill_input(
     let mut corners: Vec<u32> = surf_tris.iter().flat_map(|t| [t[0], t[1], t[2]]).collect();
     corners.sort_unstable();
     corners.dedup();
-    let local = |v: u32| corners.binary_search(&v).map_or(u32::MAX, |i| i as u32);
+    let local = |v: u32| local_index(&corners, v);
     let pts: Vec<P3> = corners.iter().map(|&c| surf_nodes[c as usize]).collect();
     let interior = interior_points(&pts, surf_tris, &local, size, outside)?;
     let faces: Vec<[u32; 3]> = surf_tris

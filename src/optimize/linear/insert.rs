@@ -110,8 +110,8 @@ pub(super) fn split_edge(
             .map(|&t| m.q[t as usize])
             .fold(f64::INFINITY, f64::min);
         if now <= old_min + eps && search_vertex(m, np, ss) {
-            // The smoother goes on from the position found.
-            m.dirty[np as usize] = true;
+            // The smoother goes on from the position found (the move marked the vertex
+            // dirty again).
             smooth_vertex(m, np, prm, ss);
         }
     }
