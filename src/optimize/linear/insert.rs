@@ -30,6 +30,9 @@ pub(super) struct InsertScratch {
     /// its position ([`search_vertex`]) before giving up (the second run of the sliver
     /// rounds, see [`super::LinearParams::sliver_passes`]).
     pub search: bool,
+    /// Where no centroid of a cavity sees all of it, grow the cavity ([`grow_cavity`];
+    /// the third run of the sliver rounds, see [`super::LinearParams::sliver_passes`]).
+    pub grow: bool,
 }
 
 /// Try splitting the interior edge (a, b); true when kept.
@@ -205,6 +208,24 @@ pub(super) fn insert_in_cavity(
     if s.ts.len() < 2 || s.ts.iter().any(|&x| m.exempt(x)) {
         return false;
     }
+    cavity_faces(m, &s.ts, &mut s.faces);
+    // Start from the best of the cavity tets' centroids where every new tet is
+    // positive; none: grow the cavity until one is ([`grow_cavity`]), or give up.
+    let np = m.pts.len() as u32;
+    let mut start: Option<(f64, P3)> = None;
+    for &x in &s.ts {
+        let p = centroid4(&m.corners(m.tets[x as usize]));
+        let lo = lowest_joined(m, &s.faces, p, np);
+        if lo > f64::NEG_INFINITY && start.map_or(true, |(b, _)| lo > b) {
+            start = Some((lo, p));
+        }
+    }
+    if start.is_none() && s.grow {
+        start = grow_cavity(m, np, s);
+    }
+    let Some((_, p)) = start else {
+        return false;
+    };
     s.old.clear();
     s.old_q.clear();
     let mut old_min = f64::INFINITY;
@@ -213,45 +234,6 @@ pub(super) fn insert_in_cavity(
         s.old.push(m.tets[x as usize]);
         s.old_q.push(m.q[x as usize]);
     }
-    // The cavity's boundary: the faces of its tets that no other of them shares, each
-    // ordered so that a point inside the cavity is on its positive side. Where the new
-    // vertex makes every (face, vertex) tet positive (exact), those tets tile the
-    // cavity: their signed volumes count each point inside it once.
-    s.faces.clear();
-    for (i, &x) in s.ts.iter().enumerate() {
-        for k in 0..4 {
-            let f = face_opposite(s.old[i], k);
-            if !m.across(x, f).is_some_and(|y| s.ts.contains(&y)) {
-                s.faces.push(f);
-            }
-        }
-    }
-    // Start from the best of the cavity tets' centroids where every new tet is
-    // positive; none: give up.
-    let np = m.pts.len() as u32;
-    let mut start: Option<(f64, P3)> = None;
-    for x in &s.old {
-        let p = centroid4(&m.corners(*x));
-        let mut lo = f64::INFINITY;
-        for f in &s.faces {
-            let c = [
-                m.pts[f[0] as usize],
-                m.pts[f[1] as usize],
-                m.pts[f[2] as usize],
-                p,
-            ];
-            lo = lo.min(m.quality_at([f[0], f[1], f[2], np], &c));
-            if lo == f64::NEG_INFINITY {
-                break;
-            }
-        }
-        if lo > f64::NEG_INFINITY && start.map_or(true, |(b, _)| lo > b) {
-            start = Some((lo, p));
-        }
-    }
-    let Some((_, p)) = start else {
-        return false;
-    };
     m.pts.push(p);
     m.vt.push(Vec::new());
     m.dirty.push(true);
@@ -280,6 +262,106 @@ pub(super) fn insert_in_cavity(
     }
     undo(m, s);
     false
+}
+
+/// Most tets a cavity of [`insert_in_cavity`] grows to ([`grow_cavity`]).
+const CAVITY_MAX_TETS: usize = 48;
+
+/// The faces of the cavity made of the tets `ts` that no other of them shares, into
+/// `faces`, each ordered so that a point inside the cavity is on its positive side.
+/// Where a new vertex makes every (face, vertex) tet positive (exact), those tets tile
+/// the cavity: their signed volumes count each point inside it once.
+fn cavity_faces(m: &LinMesh, ts: &[u32], faces: &mut Vec<[u32; 3]>) {
+    faces.clear();
+    for &x in ts {
+        let xv = m.tets[x as usize];
+        for k in 0..4 {
+            let f = face_opposite(xv, k);
+            if !m.across(x, f).is_some_and(|y| ts.contains(&y)) {
+                faces.push(f);
+            }
+        }
+    }
+}
+
+/// The lowest quality of the tets joining the new vertex `np` at `p` to `faces`
+/// (−∞ as soon as one is not positive, flat or not valid as a P2 element).
+fn lowest_joined(m: &LinMesh, faces: &[[u32; 3]], p: P3, np: u32) -> f64 {
+    let mut lo = f64::INFINITY;
+    for f in faces {
+        let c = [
+            m.pts[f[0] as usize],
+            m.pts[f[1] as usize],
+            m.pts[f[2] as usize],
+            p,
+        ];
+        lo = lo.min(m.quality_at([f[0], f[1], f[2], np], &c));
+        if lo == f64::NEG_INFINITY {
+            break;
+        }
+    }
+    lo
+}
+
+/// Where no centroid of the cavity `s.ts` sees every face of its boundary: for each
+/// centroid in turn, the tets across the faces that it does not see (joined to it, a
+/// tet not positive or not valid) join the cavity, until it sees them all, at most
+/// [`CAVITY_MAX_TETS`] tets; a face on the boundary, or an exempt tet across one, ends
+/// that centroid's try. The first centroid whose cavity closes is returned with its
+/// worst new tet's quality; `s.ts` and `s.faces` are then that cavity's. On a flat
+/// cluster of tets whose corners are all on the boundary (OpenSCAD's example020, where
+/// a revolved profile puts many boundary vertices on each meridian plane), the cavity
+/// of a tet and its neighbours is seen whole from none of its centroids.
+fn grow_cavity(m: &LinMesh, np: u32, s: &mut InsertScratch) -> Option<(f64, P3)> {
+    let first = s.ts.clone();
+    let mut best: Option<(f64, P3, Vec<u32>)> = None;
+    for &x in &first {
+        let p = centroid4(&m.corners(m.tets[x as usize]));
+        s.ts.clear();
+        s.ts.extend_from_slice(&first);
+        loop {
+            cavity_faces(m, &s.ts, &mut s.faces);
+            let mut lo = f64::INFINITY;
+            let mut hidden = None;
+            for (i, f) in s.faces.iter().enumerate() {
+                let c = [
+                    m.pts[f[0] as usize],
+                    m.pts[f[1] as usize],
+                    m.pts[f[2] as usize],
+                    p,
+                ];
+                let q = m.quality_at([f[0], f[1], f[2], np], &c);
+                if q == f64::NEG_INFINITY {
+                    hidden = Some(i);
+                    break;
+                }
+                lo = lo.min(q);
+            }
+            let Some(i) = hidden else {
+                if best.as_ref().map_or(true, |b| lo > b.0) {
+                    best = Some((lo, p, s.ts.clone()));
+                }
+                break;
+            };
+            let f = s.faces[i];
+            // The cavity tet on this face, and the tet across it.
+            let inner = s.ts.iter().copied().find(|&t| {
+                let tv = m.tets[t as usize];
+                f.iter().all(|v| tv.contains(v))
+            });
+            match inner.and_then(|t| m.across(t, f)) {
+                Some(n) if !m.exempt(n) && s.ts.len() < CAVITY_MAX_TETS => s.ts.push(n),
+                _ => break,
+            }
+        }
+    }
+    let (ts, out) = match best {
+        Some((lo, p, ts)) => (ts, Some((lo, p))),
+        None => (first, None),
+    };
+    s.ts = ts;
+    cavity_faces(m, &s.ts, &mut s.faces);
+    out
 }
 
 #[cfg(test)]
@@ -359,6 +441,68 @@ mod tests {
             new_min > 0.45 && new_min > old_min + 0.1,
             "{old_min} -> {new_min}"
         );
+    }
+
+    /// In the sliver passes, a cavity insertion that finds no centroid of the tet's
+    /// cavity seeing all of it is kept on some tets of jittered cubes once the cavity
+    /// may grow ([`grow_cavity`]), each lifting the worst score of the tets it
+    /// replaces, every tet left positive; where a centroid sees the whole cavity, growing
+    /// changes nothing.
+    #[test]
+    fn a_grown_cavity_keeps_insertions_the_fixed_one_refuses() {
+        use crate::geom::predicates::orient3d;
+        let c = cube(4, 0.08);
+        let bnd = c.boundary();
+        let mut rescued = 0;
+        for seed in 1..=4 {
+            let pts = jittered(&c, seed, 0.1);
+            let n = c.tets.len();
+            for t in 0..n {
+                let tv = c.tets[t];
+                let kept = |grow: bool| {
+                    let mut m = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+                    m.set_sliver_mode(true);
+                    if m.q[t] >= 1.0 {
+                        return None;
+                    }
+                    let mut s = InsertScratch {
+                        grow,
+                        ..Default::default()
+                    };
+                    let mut ss = SmoothScratch::default();
+                    let prm = SmoothParams::default();
+                    if !insert_in_cavity(&mut m, tv, 1e-9, &prm, &mut s, &mut ss) {
+                        return None;
+                    }
+                    let old_min = s.old_q.iter().copied().fold(f64::INFINITY, f64::min);
+                    let np = m.pts.len() - 1;
+                    let new_min = m.vt[np]
+                        .iter()
+                        .map(|&t| m.q[t as usize])
+                        .fold(f64::INFINITY, f64::min);
+                    let positive = m.vt[np].iter().all(|&x| {
+                        let p = m.corners(m.tets[x as usize]);
+                        orient3d(p[0], p[1], p[2], p[3]) > 0
+                    });
+                    Some((old_min, new_min, s.old.len(), positive, m.pts[np]))
+                };
+                let fixed = kept(false);
+                let grown = kept(true);
+                if fixed.is_some() {
+                    assert_eq!(fixed, grown, "seed {seed} tet {t}");
+                } else if let Some((old, new, cavity, positive, _)) = grown {
+                    assert!(new > old, "seed {seed} tet {t}: {old} -> {new}");
+                    assert!(positive, "seed {seed} tet {t}");
+                    assert!(cavity <= CAVITY_MAX_TETS, "{cavity}");
+                    // (Some jittered tets are inverted; a cavity with one is no sliver
+                    // pass's.)
+                    if old > f64::NEG_INFINITY {
+                        rescued += 1;
+                    }
+                }
+            }
+        }
+        assert!(rescued >= 5, "{rescued} insertions needed a grown cavity");
     }
 
     /// In the sliver passes, a split whose smoothed new vertex falls short is kept on
