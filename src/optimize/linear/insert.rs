@@ -264,8 +264,9 @@ pub(super) fn insert_in_cavity(
     false
 }
 
-/// Most tets a cavity of [`insert_in_cavity`] grows to ([`grow_cavity`]).
-const CAVITY_MAX_TETS: usize = 48;
+/// Most tets a cavity of [`insert_in_cavity`] grows to ([`grow_cavity`]; OpenSCAD
+/// corpus, unforced slivers: 260 with 48, 233 with 96, 243 with 144).
+const CAVITY_MAX_TETS: usize = 96;
 
 /// The faces of the cavity made of the tets `ts` that no other of them shares, into
 /// `faces`, each ordered so that a point inside the cavity is on its positive side.
@@ -307,37 +308,48 @@ fn lowest_joined(m: &LinMesh, faces: &[[u32; 3]], p: P3, np: u32) -> f64 {
 /// centroid in turn, the tets across the faces that it does not see (joined to it, a
 /// tet not positive or not valid) join the cavity, until it sees them all, at most
 /// [`CAVITY_MAX_TETS`] tets; a face on the boundary, or an exempt tet across one, ends
-/// that centroid's try. The first centroid whose cavity closes is returned with its
-/// worst new tet's quality; `s.ts` and `s.faces` are then that cavity's. On a flat
+/// that centroid's try. Of the centroids whose cavity closes, the one whose worst new
+/// tet is best is returned with that tet's quality; `s.ts` and `s.faces` are then its
+/// cavity's (kept as they were when none closes). `s.faces` must be the faces of
+/// `s.ts` ([`cavity_faces`]) on entry. On a flat
 /// cluster of tets whose corners are all on the boundary (OpenSCAD's example020, where
 /// a revolved profile puts many boundary vertices on each meridian plane), the cavity
 /// of a tet and its neighbours is seen whole from none of its centroids.
 fn grow_cavity(m: &LinMesh, np: u32, s: &mut InsertScratch) -> Option<(f64, P3)> {
     let first = s.ts.clone();
+    let first_faces = s.faces.clone();
+    let same = |f: [u32; 3], g: [u32; 3]| f.iter().all(|v| g.contains(v));
     let mut best: Option<(f64, P3, Vec<u32>)> = None;
+    // Per face of the cavity, the quality of its tet joined to the centroid (NaN: not
+    // measured yet); a face seen stays seen as the cavity grows.
+    let mut fq: Vec<f64> = Vec::new();
     for &x in &first {
         let p = centroid4(&m.corners(m.tets[x as usize]));
         s.ts.clear();
         s.ts.extend_from_slice(&first);
+        s.faces.clear();
+        s.faces.extend_from_slice(&first_faces);
+        fq.clear();
+        fq.resize(s.faces.len(), f64::NAN);
         loop {
-            cavity_faces(m, &s.ts, &mut s.faces);
-            let mut lo = f64::INFINITY;
             let mut hidden = None;
             for (i, f) in s.faces.iter().enumerate() {
-                let c = [
-                    m.pts[f[0] as usize],
-                    m.pts[f[1] as usize],
-                    m.pts[f[2] as usize],
-                    p,
-                ];
-                let q = m.quality_at([f[0], f[1], f[2], np], &c);
-                if q == f64::NEG_INFINITY {
+                if fq[i].is_nan() {
+                    let c = [
+                        m.pts[f[0] as usize],
+                        m.pts[f[1] as usize],
+                        m.pts[f[2] as usize],
+                        p,
+                    ];
+                    fq[i] = m.quality_at([f[0], f[1], f[2], np], &c);
+                }
+                if fq[i] == f64::NEG_INFINITY {
                     hidden = Some(i);
                     break;
                 }
-                lo = lo.min(q);
             }
             let Some(i) = hidden else {
+                let lo = fq.iter().copied().fold(f64::INFINITY, f64::min);
                 if best.as_ref().map_or(true, |b| lo > b.0) {
                     best = Some((lo, p, s.ts.clone()));
                 }
@@ -349,9 +361,28 @@ fn grow_cavity(m: &LinMesh, np: u32, s: &mut InsertScratch) -> Option<(f64, P3)>
                 let tv = m.tets[t as usize];
                 f.iter().all(|v| tv.contains(v))
             });
-            match inner.and_then(|t| m.across(t, f)) {
-                Some(n) if !m.exempt(n) && s.ts.len() < CAVITY_MAX_TETS => s.ts.push(n),
+            let n = match inner.and_then(|t| m.across(t, f)) {
+                Some(n) if !m.exempt(n) && s.ts.len() < CAVITY_MAX_TETS => n,
                 _ => break,
+            };
+            // The new tet's faces other than `f` that the cavity already has leave it;
+            // the others join it.
+            s.ts.push(n);
+            let nv = m.tets[n as usize];
+            s.faces.swap_remove(i);
+            fq.swap_remove(i);
+            for k in 0..4 {
+                let g = face_opposite(nv, k);
+                if same(g, f) {
+                    continue;
+                }
+                if let Some(j) = s.faces.iter().position(|&h| same(g, h)) {
+                    s.faces.swap_remove(j);
+                    fq.swap_remove(j);
+                } else {
+                    s.faces.push(g);
+                    fq.push(f64::NAN);
+                }
             }
         }
     }

@@ -337,7 +337,7 @@ pub fn improve_linear_known(
 /// ([`InsertScratch::grow`](insert::InsertScratch)): on a cluster of flat tets whose
 /// corners are all on the boundary, the cavity of a tet and two rings of its neighbours
 /// is often seen whole from none of its centroids (OpenSCAD's example020: 377 unforced
-/// slivers without, 157 with; allowed in the other runs too, it leaves more on some
+/// slivers without, 137 with; allowed in the other runs too, it leaves more on some
 /// parts).
 fn unforced_sliver_passes(
     m: &mut LinMesh,
