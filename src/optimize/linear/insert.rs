@@ -264,8 +264,10 @@ pub(super) fn insert_in_cavity(
     false
 }
 
-/// Most tets a cavity of [`insert_in_cavity`] grows to ([`grow_cavity`]; OpenSCAD
-/// corpus, unforced slivers: 260 with 48, 233 with 96, 243 with 144).
+/// Most tets a cavity of [`insert_in_cavity`] grows to ([`grow_cavity`]). Unforced
+/// slivers left on OpenSCAD parts: example020 140 with 48, 137 with 96, 143 with 144;
+/// projection 6, 0, 0; sign 33, 33, 35 (192: example020 146 and its sliver rounds twice
+/// as long).
 const CAVITY_MAX_TETS: usize = 96;
 
 /// The faces of the cavity made of the tets `ts` that no other of them shares, into
@@ -285,18 +287,23 @@ fn cavity_faces(m: &LinMesh, ts: &[u32], faces: &mut Vec<[u32; 3]>) {
     }
 }
 
-/// The lowest quality of the tets joining the new vertex `np` at `p` to `faces`
-/// (−∞ as soon as one is not positive, flat or not valid as a P2 element).
+/// The quality of the tet joining the new vertex `np` at `p` to the cavity face `f`
+/// (−∞ where it is not positive, flat or not valid as a P2 element).
+fn joined_quality(m: &LinMesh, f: [u32; 3], p: P3, np: u32) -> f64 {
+    let c = [
+        m.pts[f[0] as usize],
+        m.pts[f[1] as usize],
+        m.pts[f[2] as usize],
+        p,
+    ];
+    m.quality_at([f[0], f[1], f[2], np], &c)
+}
+
+/// The lowest [`joined_quality`] over `faces` (−∞ as soon as one is).
 fn lowest_joined(m: &LinMesh, faces: &[[u32; 3]], p: P3, np: u32) -> f64 {
     let mut lo = f64::INFINITY;
-    for f in faces {
-        let c = [
-            m.pts[f[0] as usize],
-            m.pts[f[1] as usize],
-            m.pts[f[2] as usize],
-            p,
-        ];
-        lo = lo.min(m.quality_at([f[0], f[1], f[2], np], &c));
+    for &f in faces {
+        lo = lo.min(joined_quality(m, f, p, np));
         if lo == f64::NEG_INFINITY {
             break;
         }
@@ -311,10 +318,10 @@ fn lowest_joined(m: &LinMesh, faces: &[[u32; 3]], p: P3, np: u32) -> f64 {
 /// that centroid's try. Of the centroids whose cavity closes, the one whose worst new
 /// tet is best is returned with that tet's quality; `s.ts` and `s.faces` are then its
 /// cavity's (kept as they were when none closes). `s.faces` must be the faces of
-/// `s.ts` ([`cavity_faces`]) on entry. On a flat
-/// cluster of tets whose corners are all on the boundary (OpenSCAD's example020, where
-/// a revolved profile puts many boundary vertices on each meridian plane), the cavity
-/// of a tet and its neighbours is seen whole from none of its centroids.
+/// `s.ts` ([`cavity_faces`]) on entry. On a flat cluster of tets whose corners are all
+/// on the boundary (OpenSCAD's example020, where a revolved profile puts many boundary
+/// vertices on each meridian plane), the cavity of a tet and its neighbours is seen
+/// whole from none of its centroids.
 fn grow_cavity(m: &LinMesh, np: u32, s: &mut InsertScratch) -> Option<(f64, P3)> {
     let first = s.ts.clone();
     let first_faces = s.faces.clone();
@@ -333,15 +340,9 @@ fn grow_cavity(m: &LinMesh, np: u32, s: &mut InsertScratch) -> Option<(f64, P3)>
         fq.resize(s.faces.len(), f64::NAN);
         loop {
             let mut hidden = None;
-            for (i, f) in s.faces.iter().enumerate() {
+            for (i, &f) in s.faces.iter().enumerate() {
                 if fq[i].is_nan() {
-                    let c = [
-                        m.pts[f[0] as usize],
-                        m.pts[f[1] as usize],
-                        m.pts[f[2] as usize],
-                        p,
-                    ];
-                    fq[i] = m.quality_at([f[0], f[1], f[2], np], &c);
+                    fq[i] = joined_quality(m, f, p, np);
                 }
                 if fq[i] == f64::NEG_INFINITY {
                     hidden = Some(i);
