@@ -33,8 +33,11 @@ pub(super) struct FlipScratch {
     verts: Vec<u32>,
 }
 
-/// Deepest multi-face removal goes from its first face: up to 1 + 3 + 6 + 12 faces.
-const MAX_FACE_DEPTH: usize = 3;
+/// Deepest multi-face removal goes from its first face (up to 1 + 3 + 6 + ... + 48
+/// faces; edges with exactly the four tets it crosses are rare, so the sets it visits
+/// stay small). On OpenSCAD's example020, unforced slivers in the finished mesh with
+/// depth 1, 3, 5 and 8: 128, 82, 73, 81 (no other part changed from 3 to 5).
+const MAX_FACE_DEPTH: usize = 5;
 
 /// A directed edge (p, q) of a face in multi-face removal's set, oriented so that the
 /// face (p, q, r) and the apex `b` make a positive tet: either it stays an edge of the

@@ -346,7 +346,7 @@ pub fn improve_linear_known(
 /// parts). Where some are still left, a fourth run, again from the start, without the
 /// searches, adds multi-face removal ([`remove_faces`]) to the grown cavities: it takes
 /// a path of its own, which ends with fewer on some parts (OpenSCAD's example020: 137 ->
-/// 82 in the finished mesh, example021: 12 -> 1) and more on others (sign: 54 at this
+/// 73 in the finished mesh, example021: 12 -> 1) and more on others (sign: 54 at this
 /// stage against the other runs' 40; tried in every run instead, sign ended with 50,
 /// example010 with 24), so it too is kept only where it leaves the fewest.
 fn unforced_sliver_passes(
