@@ -53,23 +53,27 @@ struct FaceEdge {
     across: Option<([u32; 2], [usize; 2], u32)>,
 }
 
-/// Try the 2-3 flip of the face of `t` opposite corner `k`. Applied (returns true) only
-/// when the face is interior and the three new tets have a larger minimum quality than
-/// the two old ones (by more than `eps`).
-pub(super) fn flip23(m: &mut LinMesh, t: u32, k: usize, eps: f64) -> bool {
+/// The interior face f of `t` opposite corner `k`, ordered so that (f0, f1, f2, t[k]) is
+/// positive, the tet across it, that corner and the one across; `None` for a boundary
+/// face or where either tet is exempt ([`LinMesh::exempt`]).
+fn face_pair(m: &LinMesh, t: u32, k: usize) -> Option<([u32; 3], u32, u32, u32)> {
     let tv = m.tets[t as usize];
-    let d = tv[k];
-    let f = face_opposite(tv, k); // (f0, f1, f2, d) positive
-    let Some(t2) = m.across(t, f) else {
-        return false;
-    };
+    let f = face_opposite(tv, k);
+    let t2 = m.across(t, f)?;
     let e = *m.tets[t2 as usize]
         .iter()
         .find(|x| !f.contains(x))
         .expect("a tet across a face has a fourth corner");
-    if m.exempt(t) || m.exempt(t2) {
+    (!m.exempt(t) && !m.exempt(t2)).then_some((f, t2, tv[k], e))
+}
+
+/// Try the 2-3 flip of the face of `t` opposite corner `k`. Applied (returns true) only
+/// when the face is interior and the three new tets have a larger minimum quality than
+/// the two old ones (by more than `eps`).
+pub(super) fn flip23(m: &mut LinMesh, t: u32, k: usize, eps: f64) -> bool {
+    let Some((f, t2, d, e)) = face_pair(m, t, k) else {
         return false;
-    }
+    };
     let old = m.q[t as usize].min(m.q[t2 as usize]);
     let new = [[f[0], f[1], e, d], [f[1], f[2], e, d], [f[2], f[0], e, d]];
     let mut q = [0.0; 3];
@@ -104,19 +108,10 @@ pub(super) fn remove_faces(
     eps: f64,
     s: &mut FlipScratch,
 ) -> bool {
-    let tv = m.tets[t as usize];
-    let a = tv[k];
-    let f = face_opposite(tv, k); // (f0, f1, f2, a) positive, so (f0, f2, f1, b) is.
-    let Some(t2) = m.across(t, f) else {
+    // (f0, f1, f2, a) is positive, so (f0, f2, f1, b) is.
+    let Some((f, t2, a, b)) = face_pair(m, t, k) else {
         return false;
     };
-    let b = *m.tets[t2 as usize]
-        .iter()
-        .find(|x| !f.contains(x))
-        .expect("a tet across a face has a fourth corner");
-    if m.exempt(t) || m.exempt(t2) {
-        return false;
-    }
     // An edge (a, b) already there: the new tets would overlap its tets.
     if m.vt[a as usize]
         .iter()
