@@ -235,6 +235,7 @@ fn a_cad_part_of_needles_meshes_through_the_whole_fill() {
         "{tries:?}"
     );
     assert_eq!(g.report.num_invalid, 0);
+    assert_eq!(g.report.slivers.unforced, 0, "{:?}", g.report.slivers);
     check_mesh_with_chords(&s, &g.mesh, true);
 }
 
@@ -291,12 +292,12 @@ corpus_parts! {
     example006_meshes: "example006", 11_884, 0;
     example007_meshes: "example007", 524, 0;
     example009_meshes: "example009", 1_640, 0;
-    example010_meshes: "example010", 9_542, 10;
-    example012_meshes: "example012", 916, 4;
+    example010_meshes: "example010", 9_542, 0;
+    example012_meshes: "example012", 916, 2;
     example018_meshes: "example018", 4_960, 0;
     example019_meshes: "example019", 3_912, 1;
-    example020_meshes: "example020", 8_490, 73;
-    example021_meshes: "example021", 1_280, 1;
+    example020_meshes: "example020", 8_490, 37;
+    example021_meshes: "example021", 1_280, 0;
     example023_meshes: "example023", 3_028, 0;
     example024_meshes: "example024", 12_012, 2;
     linear_extrude_meshes: "linear_extrude", 1_690, 0;
@@ -304,7 +305,7 @@ corpus_parts! {
     logo_and_text_meshes: "logo_and_text", 14_792, 6;
     projection_meshes: "projection", 1_112, 0;
     rotate_extrude_meshes: "rotate_extrude", 9_200, 0;
-    sign_meshes: "sign", 3_268, 33;
+    sign_meshes: "sign", 3_268, 2;
     surface_image_meshes: "surface_image", 6_376, 0;
     text_on_cube_meshes: "text_on_cube", 1_508, 0;
 }
