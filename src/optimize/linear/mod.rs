@@ -33,6 +33,8 @@ use insert::{insert_in_cavity, split_edge, InsertScratch};
 use mesh::LinMesh;
 pub use objective::ElementQuality;
 use smooth::{search_vertex, smooth_vertex, SmoothParams, SmoothScratch};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Tuning of the linear stage.
 #[derive(Clone, Debug)]
@@ -109,6 +111,12 @@ pub struct LinearParams {
     /// (nearly flat), with a budget of their own (one attempt per tet of the input), up
     /// to [`LinearParams::max_passes`]. None: no such passes.
     pub flat_skewness: Option<f64>,
+    /// Start the stage's second run ([`improve_linear_known`]) beside the first, on the
+    /// pool's other threads, rather than after it where the first leaves unforced
+    /// slivers; stopped as soon as the first leaves none. The same mesh either way. On
+    /// for the whole fill, where most such runs are needed; off for the front's meshes
+    /// (the 1M-tet torus would hold two meshes for nothing).
+    pub side_by_side: bool,
 }
 
 impl Default for LinearParams {
@@ -124,6 +132,7 @@ impl Default for LinearParams {
             flat_skewness: None,
             sliver_passes: 120,
             chords: false,
+            side_by_side: false,
         }
     }
 }
@@ -141,6 +150,7 @@ impl LinearParams {
         LinearParams {
             guard_slivers: true,
             flat_skewness: Some(0.95),
+            side_by_side: true,
             ..LinearParams::default()
         }
     }
@@ -229,6 +239,17 @@ struct Scratch {
     cavities: bool,
     /// Whether [`improve_tet`] also tries [`remove_faces`].
     face_removal: bool,
+    /// Set when the run's result is no longer wanted: the passes and rounds then end.
+    stop: Option<Arc<AtomicBool>>,
+}
+
+impl Scratch {
+    /// Whether [`Scratch::stop`] is set.
+    fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
+    }
 }
 
 /// Improve the straight-sided tets `tets` on `pts` (surface nodes first, as the front
@@ -256,8 +277,11 @@ pub fn improve_linear(
 /// path of its own: on the OpenSCAD parts with some left, unforced slivers in the
 /// finished mesh first -> second run: example020 73 -> 37, sign 33 -> 2, example010
 /// 10 -> 0, example012 4 -> 2, example021 1 -> 0, animation 1 -> 0, but GEB 12 -> 16 and
-/// example005 15 -> 16 (where the first, with fewer at this stage too, is kept). The
-/// second run costs that part's stage time again (sign 8 -> 14 s in all).
+/// example005 15 -> 16 (where the first, with fewer at this stage too, is kept). One
+/// after the other, the second run costs that part's stage time again (sign 8 -> 14 s
+/// in all); side by side ([`LinearParams::side_by_side`], the whole fill's), on two
+/// threads, sign takes 10 s, GEB 11.8 s as with one run, example020 40 s (43 s with one
+/// run: the second is faster), with the same meshes; at the peak, a third more memory.
 pub fn improve_linear_known(
     pts: Vec<P3>,
     tets: Vec<[u32; 4]>,
@@ -266,13 +290,34 @@ pub fn improve_linear_known(
     prm: &LinearParams,
 ) -> (Vec<P3>, Vec<[u32; 4]>, LinearStats) {
     if prm.sliver_passes == 0 {
-        return linear_run(pts, tets, known, bnd, prm, false).0;
+        return linear_run(pts, tets, known, bnd, prm, false, None).0;
     }
-    let (first, left) = linear_run(pts.clone(), tets.clone(), known, bnd, prm, false);
+    let ((first, left), second) = if prm.side_by_side {
+        let stop = Arc::new(AtomicBool::new(false));
+        let (p2, t2) = (pts.clone(), tets.clone());
+        let (first, second) = rayon::join(
+            || {
+                let r = linear_run(pts, tets, known, bnd, prm, false, None);
+                if r.1 == 0 {
+                    stop.store(true, Ordering::Relaxed);
+                }
+                r
+            },
+            || linear_run(p2, t2, known, bnd, prm, true, Some(stop.clone())),
+        );
+        (first, Ok(second))
+    } else {
+        let first = linear_run(pts.clone(), tets.clone(), known, bnd, prm, false, None);
+        (first, Err((pts, tets)))
+    };
     if left == 0 {
         return first;
     }
-    let (mut second, fewer) = linear_run(pts, tets, known, bnd, prm, true);
+    // (Err: not run yet, its input.)
+    let (mut second, fewer) = match second {
+        Ok(s) => s,
+        Err((pts, tets)) => linear_run(pts, tets, known, bnd, prm, true, None),
+    };
     let (mut kept, other) = if fewer < left {
         (second, first.2.seconds)
     } else {
@@ -297,6 +342,7 @@ fn linear_run(
     bnd: &Boundary,
     prm: &LinearParams,
     face_removal: bool,
+    stop: Option<Arc<AtomicBool>>,
 ) -> (Improved, usize) {
     let goal = 1.0 - prm.goal_skewness;
     let mut m = LinMesh::with_known(pts, tets, known, bnd, ElementQuality);
@@ -313,6 +359,7 @@ fn linear_run(
         insert: InsertScratch::default(),
         cavities: false,
         face_removal,
+        stop,
     };
     let mut order: Vec<(f64, u32, [u32; 4])> = Vec::new();
     // Clock at which each tet slot last resisted every operation (0: never); it is not
@@ -499,13 +546,14 @@ fn speculate<'a>(
     set: impl FnOnce(&mut Scratch) + Send,
     prm: &LinearParams,
 ) -> (usize, Option<(usize, (LinMesh<'a>, LinearStats))>) {
-    let stop = std::sync::atomic::AtomicBool::new(false);
+    let stop = AtomicBool::new(false);
     let smooth_prm = sc.smooth_prm;
+    let outer = sc.stop.clone();
     let (first, second) = rayon::join(
         || {
             let n = sliver_rounds(m, prm, sc, st, order, None);
             if n == 0 {
-                stop.store(true, std::sync::atomic::Ordering::Relaxed);
+                stop.store(true, Ordering::Relaxed);
             }
             n
         },
@@ -513,6 +561,7 @@ fn speculate<'a>(
             let mut o = other;
             let mut s = Scratch {
                 smooth_prm,
+                stop: outer,
                 ..Default::default()
             };
             set(&mut s);
@@ -540,9 +589,9 @@ fn sliver_rounds(
     sc: &mut Scratch,
     st: &mut LinearStats,
     order: &mut Vec<(f64, u32, [u32; 4])>,
-    stop: Option<&std::sync::atomic::AtomicBool>,
+    stop: Option<&AtomicBool>,
 ) -> usize {
-    let stopped = || stop.is_some_and(|s| s.load(std::sync::atomic::Ordering::Relaxed));
+    let stopped = |sc: &Scratch| sc.stopped() || stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
     // Goal and search threshold: a score of 1 (skewness 0 in the passes' terms);
     // no narrowing to the worst (a reach of 1 spans every score below the goal).
@@ -566,7 +615,7 @@ fn sliver_rounds(
     // cavity insertions as a last resort: only then, so that the rounds before take
     // the same path as without them (they make some parts end with more).
     loop {
-        while left > 0 && passes < prm.sliver_passes && !stopped() {
+        while left > 0 && passes < prm.sliver_passes && !stopped(sc) {
             let round = LinearParams {
                 max_passes: SLIVER_ROUND_PASSES.min(prm.sliver_passes - passes),
                 ..p.clone()
@@ -586,7 +635,7 @@ fn sliver_rounds(
             }
             left = now;
         }
-        if sc.cavities || best.0 == 0 || passes >= prm.sliver_passes || stopped() {
+        if sc.cavities || best.0 == 0 || passes >= prm.sliver_passes || stopped(sc) {
             break;
         }
         if census(m, 1.0).1 > best.0 {
@@ -645,7 +694,7 @@ fn run_passes(
     let (mut worst, start_bad) = census(m, full_goal);
     let mut out_of_reach = false;
     for _ in 0..prm.max_passes {
-        if !attempt_left(prm, st) {
+        if !attempt_left(prm, st) || sc.stopped() {
             return;
         }
         st.passes += 1;
@@ -669,7 +718,7 @@ fn run_passes(
             {
                 continue;
             }
-            if !attempt_left(prm, st) {
+            if !attempt_left(prm, st) || (st.attempts % 64 == 0 && sc.stopped()) {
                 return;
             }
             st.attempts += 1;
@@ -717,6 +766,9 @@ fn search_worst(
     worst_first(m, floor, order);
     let mut moved = false;
     for &(_, t, tv) in order.iter().take(SEARCH_MAX_TETS) {
+        if sc.stopped() {
+            break;
+        }
         for &v in &tv {
             if m.tets[t as usize] == tv
                 && m.q[t as usize] < floor
