@@ -29,8 +29,19 @@ pub(super) struct FlipScratch {
     stack: Vec<(usize, usize)>,
     /// Multi-face removal's choices, one per directed edge of the face set it visited.
     nodes: Vec<FaceEdge>,
-    /// The vertices of the face set multi-face removal chose.
+    /// Of the face set multi-face removal chose: its nodes left to walk, its vertices,
+    /// and the changes it makes, in the walk's order.
+    walk: Vec<usize>,
     verts: Vec<u32>,
+    steps: Vec<Step>,
+}
+
+/// A change of multi-face removal: the two tets on a face of its set go, or a new tet
+/// (a, b, p, q) comes on an edge (p, q) of the set's boundary.
+#[derive(Clone, Copy)]
+enum Step {
+    Remove([u32; 2]),
+    Add(u32, u32),
 }
 
 /// Deepest multi-face removal goes from its first face (up to 1 + 3 + 6 + ... + 48
@@ -113,37 +124,44 @@ pub(super) fn remove_faces(
         return false;
     };
     // An edge (a, b) already there: the new tets would overlap its tets.
-    if m.vt[a as usize]
-        .iter()
-        .any(|&x| m.tets[x as usize].contains(&b))
-    {
+    m.edge_tets(a, b, &mut s.ts);
+    if !s.ts.is_empty() {
         return false;
     }
     let floor = m.q[t as usize].min(m.q[t2 as usize]) + eps;
     s.nodes.clear();
+    s.walk.clear();
     let roots = [(f[0], f[2], f[1]), (f[2], f[1], f[0]), (f[1], f[0], f[2])];
-    let mut kids = [0usize; 3];
-    for (kid, &(p, q, r)) in kids.iter_mut().zip(&roots) {
-        *kid = face_edge(m, a, b, p, q, r, MAX_FACE_DEPTH, floor, s);
-        if s.nodes[*kid].value <= floor {
+    for &(p, q, r) in &roots {
+        let kid = face_edge(m, a, b, p, q, r, MAX_FACE_DEPTH, floor, s);
+        if s.nodes[kid].value <= floor {
             return false;
         }
+        s.walk.push(kid);
     }
-    // The set's vertices must all differ: then the faces make a disc whose vertices
-    // are all on its boundary, and the new tets fill what the old ones did.
+    // The chosen set: its vertices, and its changes.
     s.verts.clear();
     s.verts.extend_from_slice(&f);
-    s.stack.clear();
-    s.stack.extend(kids.iter().map(|&i| (i, 0)));
-    let mut faces = 1;
-    while let Some((i, _)) = s.stack.pop() {
-        if let Some((_, ch, x)) = s.nodes[i].across {
-            s.verts.push(x);
-            faces += 1;
-            s.stack.push((ch[0], 0));
-            s.stack.push((ch[1], 0));
+    s.steps.clear();
+    while let Some(i) = s.walk.pop() {
+        let n = &s.nodes[i];
+        match n.across {
+            Some((old, ch, x)) => {
+                s.verts.push(x);
+                s.steps.push(Step::Remove(old));
+                s.walk.extend_from_slice(&ch);
+            }
+            None => s.steps.push(Step::Add(n.p, n.q)),
         }
     }
+    // The set's vertices must all differ (one more per face beyond the first): then the
+    // faces make a disc whose vertices are all on its boundary, and the new tets fill
+    // what the old ones did.
+    let faces = 1 + s
+        .steps
+        .iter()
+        .filter(|x| matches!(x, Step::Remove(_)))
+        .count();
     s.verts.sort_unstable();
     s.verts.dedup();
     if s.verts.len() != faces + 2 {
@@ -151,20 +169,16 @@ pub(super) fn remove_faces(
     }
     m.remove(t);
     m.remove(t2);
-    s.stack.extend(kids.iter().map(|&i| (i, 0)));
-    while let Some((i, _)) = s.stack.pop() {
-        let n = &s.nodes[i];
-        match n.across {
-            Some((old, ch, _)) => {
-                m.remove(old[0]);
-                m.remove(old[1]);
-                s.stack.push((ch[0], 0));
-                s.stack.push((ch[1], 0));
+    for &step in &s.steps {
+        match step {
+            Step::Remove([x, y]) => {
+                m.remove(x);
+                m.remove(y);
             }
-            None => {
-                let v = [a, b, n.p, n.q];
-                let q = m.quality(v);
-                m.add(v, q);
+            Step::Add(p, q) => {
+                let v = [a, b, p, q];
+                let qv = m.quality(v);
+                m.add(v, qv);
             }
         }
     }
@@ -193,16 +207,18 @@ fn face_edge(
         value: stop,
         across: None,
     };
-    if depth > 0 {
-        if let Some((old, x)) = sandwiched_across(m, a, b, p, q, r) {
-            let c0 = face_edge(m, a, b, p, x, q, depth - 1, floor.max(stop), s);
-            let c1 = if s.nodes[c0].value > floor.max(stop) {
-                face_edge(m, a, b, x, q, p, depth - 1, floor.max(stop), s)
-            } else {
-                c0
-            };
+    // Going across must beat stopping here (and the floor): the children's values at or
+    // below that are never used.
+    let beat = floor.max(stop);
+    if let Some((old, x)) = (depth > 0)
+        .then(|| sandwiched_across(m, a, b, p, q, r))
+        .flatten()
+    {
+        let c0 = face_edge(m, a, b, p, x, q, depth - 1, beat, s);
+        if s.nodes[c0].value > beat {
+            let c1 = face_edge(m, a, b, x, q, p, depth - 1, beat, s);
             let v = s.nodes[c0].value.min(s.nodes[c1].value);
-            if c1 != c0 && v > stop && v > floor {
+            if v > beat {
                 node.value = v;
                 node.across = Some((old, [c0, c1], x));
             }

@@ -13,7 +13,8 @@
 //! found, later passes aim at the worst tets only ([`LinearParams::reach`]). Last, the
 //! sliver rounds ([`LinearParams::sliver_passes`]); where they leave unforced slivers,
 //! the stage runs a second time with multi-face removal in every pass
-//! ([`improve_linear_known`]). Deterministic: sequential but for the trial points of a vertex search, which run on
+//! ([`improve_linear_known`]). Deterministic: the trial points of a vertex search, the
+//! sliver rounds' runs two at a time, and on a whole fill the stage's two runs, go on
 //! the threads of the rayon pool the stage is called in, with the same result on any
 //! number.
 
@@ -174,7 +175,7 @@ pub struct LinearStats {
     pub flips23: usize,
     /// Edge removals applied (3-2, 4-4, n-to-(2n-4)).
     pub edge_removals: usize,
-    /// Multi-face removals applied (of two faces or more).
+    /// Multi-face removals applied (of two faces or more: one is a 2-3 flip, tried first).
     pub face_removals: usize,
     /// The run kept made multi-face removals in every pass (see
     /// [`improve_linear_known`]).
@@ -239,16 +240,15 @@ struct Scratch {
     cavities: bool,
     /// Whether [`improve_tet`] also tries [`remove_faces`].
     face_removal: bool,
-    /// Set when the run's result is no longer wanted: the passes and rounds then end.
-    stop: Option<Arc<AtomicBool>>,
+    /// Any of these set: the run's result is no longer wanted, and its passes, searches
+    /// and rounds end.
+    stops: Vec<Arc<AtomicBool>>,
 }
 
 impl Scratch {
-    /// Whether [`Scratch::stop`] is set.
+    /// Whether one of [`Scratch::stops`] is set.
     fn stopped(&self) -> bool {
-        self.stop
-            .as_ref()
-            .is_some_and(|s| s.load(Ordering::Relaxed))
+        self.stops.iter().any(|s| s.load(Ordering::Relaxed))
     }
 }
 
@@ -290,24 +290,32 @@ pub fn improve_linear_known(
     prm: &LinearParams,
 ) -> (Vec<P3>, Vec<[u32; 4]>, LinearStats) {
     if prm.sliver_passes == 0 {
-        return linear_run(pts, tets, known, bnd, prm, false, None).0;
+        return linear_run(pts, tets, known, bnd, prm, false, Vec::new()).0;
     }
     let ((first, left), second) = if prm.side_by_side {
         let stop = Arc::new(AtomicBool::new(false));
         let (p2, t2) = (pts.clone(), tets.clone());
         let (first, second) = rayon::join(
             || {
-                let r = linear_run(pts, tets, known, bnd, prm, false, None);
+                let r = linear_run(pts, tets, known, bnd, prm, false, Vec::new());
                 if r.1 == 0 {
                     stop.store(true, Ordering::Relaxed);
                 }
                 r
             },
-            || linear_run(p2, t2, known, bnd, prm, true, Some(stop.clone())),
+            || linear_run(p2, t2, known, bnd, prm, true, vec![stop.clone()]),
         );
         (first, Ok(second))
     } else {
-        let first = linear_run(pts.clone(), tets.clone(), known, bnd, prm, false, None);
+        let first = linear_run(
+            pts.clone(),
+            tets.clone(),
+            known,
+            bnd,
+            prm,
+            false,
+            Vec::new(),
+        );
         (first, Err((pts, tets)))
     };
     if left == 0 {
@@ -316,7 +324,7 @@ pub fn improve_linear_known(
     // (Err: not run yet, its input.)
     let (mut second, fewer) = match second {
         Ok(s) => s,
-        Err((pts, tets)) => linear_run(pts, tets, known, bnd, prm, true, None),
+        Err((pts, tets)) => linear_run(pts, tets, known, bnd, prm, true, Vec::new()),
     };
     let (mut kept, other) = if fewer < left {
         (second, first.2.seconds)
@@ -342,7 +350,7 @@ fn linear_run(
     bnd: &Boundary,
     prm: &LinearParams,
     face_removal: bool,
-    stop: Option<Arc<AtomicBool>>,
+    stops: Vec<Arc<AtomicBool>>,
 ) -> (Improved, usize) {
     let goal = 1.0 - prm.goal_skewness;
     let mut m = LinMesh::with_known(pts, tets, known, bnd, ElementQuality);
@@ -359,7 +367,7 @@ fn linear_run(
         insert: InsertScratch::default(),
         cavities: false,
         face_removal,
-        stop,
+        stops,
     };
     let mut order: Vec<(f64, u32, [u32; 4])> = Vec::new();
     // Clock at which each tet slot last resisted every operation (0: never); it is not
@@ -546,12 +554,15 @@ fn speculate<'a>(
     set: impl FnOnce(&mut Scratch) + Send,
     prm: &LinearParams,
 ) -> (usize, Option<(usize, (LinMesh<'a>, LinearStats))>) {
-    let stop = AtomicBool::new(false);
+    let stop = Arc::new(AtomicBool::new(false));
     let smooth_prm = sc.smooth_prm;
-    let outer = sc.stop.clone();
+    // The second run ends where the first leaves none, and where the run they are part
+    // of is no longer wanted.
+    let mut stops = sc.stops.clone();
+    stops.push(stop.clone());
     let (first, second) = rayon::join(
         || {
-            let n = sliver_rounds(m, prm, sc, st, order, None);
+            let n = sliver_rounds(m, prm, sc, st, order);
             if n == 0 {
                 stop.store(true, Ordering::Relaxed);
             }
@@ -561,18 +572,11 @@ fn speculate<'a>(
             let mut o = other;
             let mut s = Scratch {
                 smooth_prm,
-                stop: outer,
+                stops,
                 ..Default::default()
             };
             set(&mut s);
-            let n = sliver_rounds(
-                &mut o.0,
-                prm,
-                &mut s,
-                &mut o.1,
-                &mut Vec::new(),
-                Some(&stop),
-            );
+            let n = sliver_rounds(&mut o.0, prm, &mut s, &mut o.1, &mut Vec::new());
             (n, o)
         },
     );
@@ -582,16 +586,15 @@ fn speculate<'a>(
 
 /// The rounds of [`unforced_sliver_passes`] on `m` (in sliver mode, with some unforced
 /// sliver); `m` ends as the round that left the fewest, and that count is returned.
-/// Where `stop` is set before they end, they end early: their result is then not used.
+/// Where [`Scratch::stops`] says so before they end, they end early: their result is
+/// then not used.
 fn sliver_rounds(
     m: &mut LinMesh,
     prm: &LinearParams,
     sc: &mut Scratch,
     st: &mut LinearStats,
     order: &mut Vec<(f64, u32, [u32; 4])>,
-    stop: Option<&AtomicBool>,
 ) -> usize {
-    let stopped = |sc: &Scratch| sc.stopped() || stop.is_some_and(|s| s.load(Ordering::Relaxed));
     let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
     // Goal and search threshold: a score of 1 (skewness 0 in the passes' terms);
     // no narrowing to the worst (a reach of 1 spans every score below the goal).
@@ -615,7 +618,7 @@ fn sliver_rounds(
     // cavity insertions as a last resort: only then, so that the rounds before take
     // the same path as without them (they make some parts end with more).
     loop {
-        while left > 0 && passes < prm.sliver_passes && !stopped(sc) {
+        while left > 0 && passes < prm.sliver_passes && !sc.stopped() {
             let round = LinearParams {
                 max_passes: SLIVER_ROUND_PASSES.min(prm.sliver_passes - passes),
                 ..p.clone()
@@ -635,7 +638,7 @@ fn sliver_rounds(
             }
             left = now;
         }
-        if sc.cavities || best.0 == 0 || passes >= prm.sliver_passes || stopped(sc) {
+        if sc.cavities || best.0 == 0 || passes >= prm.sliver_passes || sc.stopped() {
             break;
         }
         if census(m, 1.0).1 > best.0 {
