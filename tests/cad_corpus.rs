@@ -47,9 +47,15 @@ const HANDED_OVER: [&str; 4] = ["example002", "example001", "example022", "offse
 const FILL_FIRST: [&str; 3] = ["example002", "example022", "offset"];
 
 /// OpenSCAD part `name`'s STL: `tests/data/openscad/NAME.stl`, or, for the larger parts
-/// kept gzipped in git (`NAME.stl.gz`), a decompressed copy, deleted when dropped.
+/// kept gzipped in git (`NAME.stl.gz`), a decompressed copy, deleted when dropped. A
+/// name with a folder (`csg/bracket`) is under `tests/data` instead.
 fn path(name: &str) -> Stl {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/openscad");
+    let data = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let dir = if name.contains('/') {
+        data
+    } else {
+        data.join("openscad")
+    };
     let plain = dir.join(format!("{name}.stl"));
     if plain.exists() {
         return Stl::Plain(plain);
@@ -237,6 +243,24 @@ fn a_cad_part_of_needles_meshes_through_the_whole_fill() {
     assert_eq!(g.report.num_invalid, 0);
     assert_eq!(g.report.slivers.unforced, 0, "{:?}", g.report.slivers);
     check_mesh_with_chords(&s, &g.mesh, true);
+}
+
+/// A CSG bracket (`scripts/csg-parts.py bracket`: a 120 x 60 x 3 plate with three holes
+/// and two bosses through it; 1,248 triangles, its planar faces fans of needles up to
+/// aspect ratio 13,161). The front stalls on the needles; the whole fill at crossings and by halving
+/// both failed: each fan edge crosses many Delaunay edges of its plane exactly, and the
+/// points at the crossings, rounded a hair off the plane, cut the later pieces ever
+/// shorter (over a hundred points on one edge). Flips in the plane recover those edges
+/// with no point, and the fill closes.
+#[test]
+fn a_csg_bracket_meshes_with_flips_in_its_planes() {
+    let g = corpus_part_meshes("csg/bracket", 1_248, true, 13);
+    let tries = &g.front.whole_fill_tries;
+    assert_eq!(
+        tries.iter().map(|t| t.steiner_at).collect::<Vec<_>>(),
+        ["crossings", "halves", "planes, crossings"],
+        "{tries:?}"
+    );
 }
 
 /// One test per part of the OpenSCAD corpus not meshed above (the larger ones are kept

@@ -86,11 +86,17 @@ pub(crate) fn whole_fill(
         let clock = std::time::Instant::now();
         let dt = cdt_fill::delaunay(&all);
         let mut built = clock.elapsed().as_secs_f64();
-        for split in [Split::AtCrossing, Split::Halving] {
+        // Flips in planes where both fail, with the points inside.
+        let splits: &[Split] = if with_outside {
+            &[Split::AtCrossing, Split::Halving]
+        } else {
+            &[Split::AtCrossing, Split::Halving, Split::InPlane]
+        };
+        for &split in splits {
             // Halving follows a try at crossings, so that one may give up early.
             // The last try has no other way after it.
             let patience = match split {
-                Split::AtCrossing => Patience::GiveUpEarly,
+                Split::AtCrossing | Split::InPlane => Patience::GiveUpEarly,
                 Split::Halving if with_outside => Patience::LastResort,
                 Split::Halving => Patience::Exhaustive,
             };
@@ -110,6 +116,7 @@ pub(crate) fn whole_fill(
                 steiner_at: match split {
                     Split::AtCrossing => "crossings",
                     Split::Halving => "halves",
+                    Split::InPlane => "planes, crossings",
                 },
                 points_outside: with_outside,
                 error: r.as_ref().err().map(|e| e.to_string()),

@@ -3,9 +3,10 @@
 //! strictly inside. The advancing front hands it what it cannot close.
 //!
 //! 1. Delaunay tetrahedralization of the surface's vertices ([`Delaunay`]).
-//! 2. Edge recovery: flips first; where they cannot, a Steiner point where the segment
-//!    leaves the tet at its current end (a face split, or an edge split when it crosses an
-//!    edge), walking to the other end; or ([`Split::Halving`]) one inside the piece at
+//! 2. Edge recovery: flips first (with [`Split::InPlane`], flips in the plane of
+//!    coplanar surface points before them: `plane_flips`); where they cannot, a Steiner
+//!    point where the segment leaves the tet at its current end (a face split, or an edge
+//!    split when it crosses an edge), walking to the other end; or ([`Split::Halving`]) one inside the piece at
 //!    the projection of the vertex that encroaches on it most (TetGen's reference
 //!    point), else halfway. Recovered pieces are fixed: no flip removes them.
 //! 3. Face recovery: every mesh edge that crosses a triangle's interior is split at the
@@ -168,6 +169,11 @@ pub(crate) enum Split {
     /// on it most, else halfway ([`Cdt::reference_fraction`]): points off the faces,
     /// where crossings pile up next to nearly flat tets (a second try on CAD parts).
     Halving,
+    /// [`Split::AtCrossing`], after flips in the plane of coplanar surface points where a
+    /// piece crosses only edges in it ([`Delaunay::recover_in_plane`]): a CAD facet's fan
+    /// of needles comes in without points a hair off its plane. Tried where the others
+    /// fail (on a CSG bracket both did); where they close, their meshes are kept.
+    InPlane,
 }
 
 /// How long the fill keeps moving Steiner points off the surface when many stay on it.
@@ -347,7 +353,10 @@ impl<'a> Cdt<'a> {
             let Some(&goal) = goals.last() else {
                 return Ok(chain);
             };
-            if self.dt.recover_edge(cur, goal, 32) || self.dt.recover_edge_any(cur, goal, 32) {
+            if (self.split == Split::InPlane && self.dt.recover_in_plane(cur, goal))
+                || self.dt.recover_edge(cur, goal, 32)
+                || self.dt.recover_edge_any(cur, goal, 32)
+            {
                 chain.push(goal);
                 self.dt.fixed_edges.insert(sorted2(cur, goal));
                 cur = goal;

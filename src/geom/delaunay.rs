@@ -552,14 +552,11 @@ impl Delaunay {
         true
     }
 
-    /// Edge removal (n-to-2n-4 flip): replace the `around` tets sharing edge (x, y) by
-    /// tets on a fan triangulation of their ring of other vertices, joined to x and to y,
-    /// trying a fan from each ring vertex. False (nothing changed) if none is valid.
-    pub(crate) fn remove_edge(&mut self, x: u32, y: u32, around: &[u32]) -> bool {
+    /// The ring of edge (x, y): the other vertices of the `around` tets (those sharing
+    /// the edge), in order around it, each consecutive pair (and the last with the first)
+    /// the other edge of one tet. None when the tets do not close up into one ring.
+    pub(crate) fn edge_ring(&self, x: u32, y: u32, around: &[u32]) -> Option<Vec<u32>> {
         let n = around.len();
-        if !(3..=10).contains(&n) || self.fixed_edges.contains(&sorted2(x, y)) {
-            return false;
-        }
         // Each tet contributes the ring edge of its two other vertices; chain them.
         let mut links: Vec<[u32; 2]> = Vec::with_capacity(n);
         for &t in around {
@@ -569,18 +566,16 @@ impl Delaunay {
                 .filter(|&v| v != x && v != y)
                 .collect();
             if o.len() != 2 {
-                return false;
+                return None;
             }
             links.push([o[0], o[1]]);
         }
-        let mut ring = vec![links[0][0], links[0][1]];
+        let mut ring = vec![links.first()?[0], links[0][1]];
         let mut used = vec![false; n];
         used[0] = true;
         while ring.len() < n {
-            let last = *ring.last().unwrap_or(&NONE);
-            let Some(j) = (0..n).find(|&j| !used[j] && links[j].contains(&last)) else {
-                return false;
-            };
+            let last = *ring.last()?;
+            let j = (0..n).find(|&j| !used[j] && links[j].contains(&last))?;
             used[j] = true;
             let next = if links[j][0] == last {
                 links[j][1]
@@ -590,12 +585,21 @@ impl Delaunay {
             ring.push(next);
         }
         // The ring closes back to its start.
-        let Some(j) = (0..n).find(|&j| !used[j]) else {
-            return false;
-        };
-        if !(links[j].contains(&ring[0]) && links[j].contains(&ring[n - 1])) {
+        let j = (0..n).find(|&j| !used[j])?;
+        (links[j].contains(&ring[0]) && links[j].contains(&ring[n - 1])).then_some(ring)
+    }
+
+    /// Edge removal (n-to-2n-4 flip): replace the `around` tets sharing edge (x, y) by
+    /// tets on a fan triangulation of their ring of other vertices, joined to x and to y,
+    /// trying a fan from each ring vertex. False (nothing changed) if none is valid.
+    pub(crate) fn remove_edge(&mut self, x: u32, y: u32, around: &[u32]) -> bool {
+        let n = around.len();
+        if !(3..=10).contains(&n) || self.fixed_edges.contains(&sorted2(x, y)) {
             return false;
         }
+        let Some(ring) = self.edge_ring(x, y, around) else {
+            return false;
+        };
         'fans: for apex in 0..n {
             let mut new = Vec::with_capacity(2 * (n - 2));
             for k in 1..n - 1 {

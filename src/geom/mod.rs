@@ -5,6 +5,7 @@ pub mod bezier;
 pub(crate) mod cdt_fill;
 pub(crate) mod delaunay;
 pub mod distance;
+pub(crate) mod plane_flips;
 pub mod predicates;
 pub mod quadrature;
 pub mod shape;
