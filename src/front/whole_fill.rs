@@ -86,17 +86,18 @@ pub(crate) fn whole_fill(
         let clock = std::time::Instant::now();
         let dt = cdt_fill::delaunay(&all);
         let mut built = clock.elapsed().as_secs_f64();
-        // Flips in planes where both fail, with the points inside.
+        // Where both fail, with the points inside: crossings after flips in planes, and
+        // no numerically flat tet in the recovery.
         let splits: &[Split] = if with_outside {
             &[Split::AtCrossing, Split::Halving]
         } else {
-            &[Split::AtCrossing, Split::Halving, Split::InPlane]
+            &[Split::AtCrossing, Split::Halving, Split::NoFlatTets]
         };
         for &split in splits {
             // Halving follows a try at crossings, so that one may give up early.
             // The last try has no other way after it.
             let patience = match split {
-                Split::AtCrossing | Split::InPlane => Patience::GiveUpEarly,
+                Split::AtCrossing | Split::NoFlatTets => Patience::GiveUpEarly,
                 Split::Halving if with_outside => Patience::LastResort,
                 Split::Halving => Patience::Exhaustive,
             };
@@ -116,7 +117,7 @@ pub(crate) fn whole_fill(
                 steiner_at: match split {
                     Split::AtCrossing => "crossings",
                     Split::Halving => "halves",
-                    Split::InPlane => "planes, crossings",
+                    Split::NoFlatTets => "no flat tets",
                 },
                 points_outside: with_outside,
                 error: r.as_ref().err().map(|e| e.to_string()),

@@ -3,8 +3,9 @@
 //! strictly inside. The advancing front hands it what it cannot close.
 //!
 //! 1. Delaunay tetrahedralization of the surface's vertices ([`Delaunay`]).
-//! 2. Edge recovery: flips first (with [`Split::InPlane`], flips in the plane of
-//!    coplanar surface points before them: `plane_flips`); where they cannot, a Steiner
+//! 2. Edge recovery: flips first (with [`Split::NoFlatTets`], flips in the plane of
+//!    coplanar surface points before them, `plane_flips`, and no numerically flat tet
+//!    made, the starting ones flipped out); where they cannot, a Steiner
 //!    point where the segment leaves the tet at its current end (a face split, or an edge
 //!    split when it crosses an edge), walking to the other end; or ([`Split::Halving`]) one inside the piece at
 //!    the projection of the vertex that encroaches on it most (TetGen's reference
@@ -116,6 +117,10 @@ pub(crate) fn fill_from(
     };
     let n = dt.n;
     let mut c = Cdt::new(dt, faces, split, patience)?;
+    if split == Split::NoFlatTets {
+        c.flip_flat_tets();
+        c.dt.refuse_flat = true;
+    }
     let r = c.recover_edges();
     stages.edges = lap();
     stages.steiner_points = c.dt.pts.len() - n - 4;
@@ -124,6 +129,7 @@ pub(crate) fn fill_from(
     stages.faces = lap();
     stages.steiner_points = c.dt.pts.len() - n - 4;
     r?;
+    c.dt.refuse_flat = false;
     c.keep_enclosed()?;
     let r = c.remove_steiner_points();
     stages.steiner_removal = lap();
@@ -170,10 +176,17 @@ pub(crate) enum Split {
     /// where crossings pile up next to nearly flat tets (a second try on CAD parts).
     Halving,
     /// [`Split::AtCrossing`], after flips in the plane of coplanar surface points where a
-    /// piece crosses only edges in it ([`Delaunay::recover_in_plane`]): a CAD facet's fan
-    /// of needles comes in without points a hair off its plane. Tried where the others
-    /// fail (on a CSG bracket both did); where they close, their meshes are kept.
-    InPlane,
+    /// piece crosses only edges in it ([`Delaunay::recover_in_plane`]), and with no
+    /// numerically flat tet anywhere in the recovery: those of the starting Delaunay
+    /// tetrahedralization are flipped out first ([`Cdt::flip_flat_tets`]), and no flip,
+    /// split or insertion of the recovery makes one (`Delaunay::refuse_flat`). A CAD
+    /// facet's fan of needles then comes in without points a hair off its plane, and a
+    /// segment crossing a set of points coplanar only within rounding (the meridian of a
+    /// revolved surface at 180 degrees, whose Delaunay tets there are flat) crosses
+    /// it once, through a face, not through flat tets whose crossings fall within
+    /// rounding of each other. Tried where the others fail (on a CSG bracket and on aniso
+    /// tori of 12 segments both did); where they close, their meshes are kept.
+    NoFlatTets,
 }
 
 /// How long the fill keeps moving Steiner points off the surface when many stay on it.
@@ -214,6 +227,10 @@ const HALVING_DEPTH: i32 = 10;
 /// at least this fraction of the piece from either end ([`Cdt::reference_fraction`]);
 /// TetGen's value: nearer an end, the new piece would be short next to that end.
 const REFERENCE_MARGIN: f64 = 0.2;
+
+/// Rounds of [`Cdt::flip_flat_tets`] (on aniso tori of 12 segments: 106 flat tets, 16
+/// after the first round, 2 after the second, which no flip removes).
+const FLAT_FLIP_ROUNDS: usize = 4;
 
 /// Flips tried per segment or face to clear nearly flat tets out of a split's way.
 const MAX_UNBLOCK: usize = 64;
@@ -316,6 +333,30 @@ impl<'a> Cdt<'a> {
         })
     }
 
+    /// Flip the numerically flat tets out of the starting tetrahedralization, by flips
+    /// that make none ([`Split::NoFlatTets`]), a few rounds while some go.
+    fn flip_flat_tets(&mut self) {
+        let flat = |dt: &Delaunay, t: u32| {
+            dt.alive[t as usize] && numerically_flat(&dt.tets[t as usize].map(|v| dt.p(v)))
+        };
+        self.dt.refuse_flat = true;
+        for _ in 0..FLAT_FLIP_ROUNDS {
+            let list: Vec<u32> = (0..self.dt.tets.len() as u32)
+                .filter(|&t| flat(&self.dt, t))
+                .collect();
+            let mut flipped = false;
+            for t in list {
+                if flat(&self.dt, t) && self.dt.flip_away(&[t]) {
+                    flipped = true;
+                }
+            }
+            if !flipped {
+                break;
+            }
+        }
+        self.dt.refuse_flat = false;
+    }
+
     fn recover_edges(&mut self) -> Result<(), &'static str> {
         let mut edges: Vec<[u32; 2]> = self
             .faces
@@ -353,7 +394,7 @@ impl<'a> Cdt<'a> {
             let Some(&goal) = goals.last() else {
                 return Ok(chain);
             };
-            if (self.split == Split::InPlane && self.dt.recover_in_plane(cur, goal))
+            if (self.split == Split::NoFlatTets && self.dt.recover_in_plane(cur, goal))
                 || self.dt.recover_edge(cur, goal, 32)
                 || self.dt.recover_edge_any(cur, goal, 32)
             {
@@ -1760,17 +1801,19 @@ mod tests {
     /// Fill `faces` (outward, as surfaces are stored) and check the result: positive tets,
     /// boundary exactly the input, volume the enclosed one.
     fn fill_and_check(pts: &[P3], outward: &[[u32; 3]]) -> Result<Filled, String> {
+        fill_and_check_with(pts, outward, Split::AtCrossing)
+    }
+
+    /// [`fill_and_check`] with Steiner points placed by `split`.
+    fn fill_and_check_with(
+        pts: &[P3],
+        outward: &[[u32; 3]],
+        split: Split,
+    ) -> Result<Filled, String> {
         let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
         let mut stages = Stages::default();
-        let r = fill(
-            pts,
-            &faces,
-            Split::AtCrossing,
-            None,
-            Patience::Exhaustive,
-            &mut stages,
-        )
-        .map_err(|e| e.to_string())?;
+        let r = fill(pts, &faces, split, None, Patience::Exhaustive, &mut stages)
+            .map_err(|e| e.to_string())?;
         assert_eq!(&r.pts[..pts.len()], pts);
         let mut vol = 0.0;
         let mut uses: HashMap<[u32; 3], i32> = HashMap::default();
@@ -1904,8 +1947,14 @@ mod tests {
     /// hardest use of the fill (coplanar faces, cospherical points everywhere).
     /// The corner points and outward triangles of `tests/data/openscad/NAME.stl`.
     fn openscad_corners(name: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
+        surface_corners(&format!("openscad/{name}.stl"))
+    }
+
+    /// The corner points and outward triangles of `tests/data/FILE`.
+    fn surface_corners(file: &str) -> (Vec<P3>, Vec<[u32; 3]>) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("tests/data/openscad/{name}.stl"));
+            .join("tests/data")
+            .join(file);
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let corners = s.corner_nodes();
         let local = |v: u32| corners.binary_search(&v).unwrap() as u32;
@@ -2022,5 +2071,36 @@ mod tests {
             .count();
         assert!(r.pts.len() > pts.len(), "offset needs Steiner points");
         assert_eq!(hugging, 0, "Steiner points hugging the surface");
+    }
+
+    /// An aniso torus of 12 segments around its axis (`tests/data/tori/aniso_12x44.off`):
+    /// its meridian at 180 degrees is coplanar only within rounding, and the Delaunay
+    /// tetrahedralization of its corners has over a hundred numerically flat tets there.
+    /// At crossings, the fill fails (Steiner points within rounding of each other on a
+    /// segment through them); flipped out first, and none made in the recovery, it
+    /// closes, its boundary the input's.
+    #[test]
+    fn a_layer_coplanar_within_rounding_fills_without_flat_tets() {
+        let (pts, outward) = surface_corners("tori/aniso_12x44.off");
+        assert!(fill_and_check(&pts, &outward).is_err());
+        let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        let mut c = Cdt::new(
+            Delaunay::new(&pts),
+            &faces,
+            Split::NoFlatTets,
+            Patience::Exhaustive,
+        )
+        .unwrap();
+        let flat = |c: &Cdt| {
+            (0..c.dt.tets.len())
+                .filter(|&t| c.dt.alive[t] && numerically_flat(&c.dt.tets[t].map(|v| c.dt.p(v))))
+                .count()
+        };
+        let before = flat(&c);
+        c.flip_flat_tets();
+        let after = flat(&c);
+        assert!(before > 100 && after <= 2, "{before} -> {after} flat tets");
+        let r = fill_and_check_with(&pts, &outward, Split::NoFlatTets).unwrap();
+        assert!(r.tets.len() >= outward.len() / 4);
     }
 }

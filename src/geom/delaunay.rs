@@ -80,6 +80,10 @@ pub(crate) struct Delaunay {
     /// The tets [`Delaunay::walk_around`] has reached, reused from walk to walk (a hash
     /// set per walk cost more than the walk itself).
     walked: RefCell<Stamps>,
+    /// Whether [`Delaunay::valid_new`] also refuses numerically flat tets (6 x volume
+    /// below 1e-12 of the longest edge cubed): the constrained fill's recovery then
+    /// makes none (`cdt_fill::Split::NoFlatTets`).
+    pub refuse_flat: bool,
 }
 
 /// Per-tet marks, each walk's with a new stamp: clearing them is one increment.
@@ -176,6 +180,7 @@ impl Delaunay {
             last: 0,
             magnitude: pts.iter().flatten().fold(0.0, |m, x| m.max(x.abs())),
             walked: RefCell::default(),
+            refuse_flat: false,
         };
         for i in 0..n as u32 {
             dt.insert(i);
@@ -386,6 +391,9 @@ impl Delaunay {
     /// (an added point standing for the input edge or face it was put on) all on one
     /// plane of input points, exactly, so that only rounding makes it positive.
     pub(crate) fn valid_new(&self, t: [u32; 4]) -> bool {
+        if self.refuse_flat && super::tet_quality::numerically_flat(&t.map(|v| self.p(v))) {
+            return false;
+        }
         self.positive(t)
             && (self.clearly_solid(t) || !self.flat_by_construction(t))
             && (self.clearly_solid(t)
