@@ -184,8 +184,8 @@ pub(crate) enum Split {
     /// segment crossing a set of points coplanar only within rounding (the meridian of a
     /// revolved surface at 180 degrees, whose Delaunay tets there are flat) crosses
     /// it once, through a face, not through flat tets whose crossings fall within
-    /// rounding of each other. Tried where the others fail (on a CSG bracket and on aniso
-    /// tori of 12 segments both did); where they close, their meshes are kept.
+    /// rounding of each other. The whole fill's first try (on a CSG bracket and on aniso
+    /// tori of 12 segments the other two failed).
     NoFlatTets,
 }
 
