@@ -204,20 +204,23 @@ fn a_cad_part_meshes_with_its_uncertifiable_edges_straightened() {
 /// segment crossings stayed on the surface (952 of 3,448 after the first round), so the
 /// fill gave up on them and halved the segments instead. Edge removals during recovery
 /// had made overlapping tets (a volume check let them through); with the exact check the
-/// first try fills at its crossings (now with no numerically flat tet in the recovery),
-/// with a fraction of the points. The part meshes, certified, with a few boundary edges
-/// on their chords.
+/// try at its crossings fills, with a fraction of the points. It follows the try with no
+/// numerically flat tet in the recovery, which stops here: a split it would need makes
+/// one. The part meshes, certified, with a few boundary edges on their chords.
 #[test]
 fn a_cad_part_fills_at_its_crossings_at_once() {
     let (s, g) = read_and_mesh("CSG", 3_004);
     assert!(g.front.whole_fill);
     let tries = &g.front.whole_fill_tries;
-    assert_eq!(tries.len(), 1, "{tries:?}");
     assert_eq!(
-        (tries[0].steiner_at, tries[0].error.as_deref()),
-        ("no flat tets", None)
+        tries
+            .iter()
+            .map(|t| (t.steiner_at, t.error.is_none()))
+            .collect::<Vec<_>>(),
+        [("no flat tets", false), ("crossings", true)],
+        "{tries:?}"
     );
-    assert!((1..1_000).contains(&tries[0].steiner_points), "{tries:?}");
+    assert!((1..1_000).contains(&tries[1].steiner_points), "{tries:?}");
     assert_eq!(g.report.num_invalid, 0);
     check_mesh_with_chords(&s, &g.mesh, true);
     // No unforced sliver: the tets flattened against edges that go on their chords are
