@@ -45,6 +45,23 @@ pub(crate) fn whole_fill(
     surf_tris: &[[u32; 6]],
     size: &SizeField,
 ) -> Result<FrontOutput, String> {
+    whole_fill_trying(surf_nodes, surf_tris, size, INSIDE_TRIES)
+}
+
+/// The tries of [`whole_fill`] with the points inside, in order. On the OpenSCAD corpus
+/// the try with no flat tets first left 63 unforced slivers where the try at crossings
+/// first left 77 (example005 15 -> 9, example020 37 -> 29, no part more), and it fills
+/// what both others fail on (a CSG bracket, 12-segment aniso tori).
+const INSIDE_TRIES: &[Split] = &[Split::NoFlatTets, Split::AtCrossing, Split::Halving];
+
+/// [`whole_fill`] with the tries `inside` with the points inside (the tests of the
+/// linear stage's passes keep the fill they were measured on).
+fn whole_fill_trying(
+    surf_nodes: &[P3],
+    surf_tris: &[[u32; 6]],
+    size: &SizeField,
+    inside: &[Split],
+) -> Result<FrontOutput, String> {
     let clock = std::time::Instant::now();
     let FillInput {
         corners,
@@ -87,14 +104,10 @@ pub(crate) fn whole_fill(
         let clock = std::time::Instant::now();
         let dt = cdt_fill::delaunay(&all);
         let mut built = clock.elapsed().as_secs_f64();
-        // On the OpenSCAD corpus the try with no flat tets first left 63 unforced slivers
-        // where the try at crossings first left 77 (example005 15 -> 9, example020
-        // 37 -> 29, no part more), and it fills what both others fail on (a CSG
-        // bracket, 12-segment aniso tori).
         let splits: &[Split] = if with_outside {
             &[Split::AtCrossing, Split::Halving]
         } else {
-            &[Split::NoFlatTets, Split::AtCrossing, Split::Halving]
+            inside
         };
         for &split in splits {
             // Halving follows a try at crossings, so that one may give up early.
@@ -400,7 +413,15 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
-        let out = whole_fill(s.nodes(), s.triangles(), &size).unwrap();
+        // The fill at crossings first, as the passes were measured on (with no flat
+        // tets first, example002's fill leaves the passes far less to do).
+        let out = whole_fill_trying(
+            s.nodes(),
+            s.triangles(),
+            &size,
+            &[Split::AtCrossing, Split::Halving],
+        )
+        .unwrap();
         assert_eq!(&out.pts[..s.nodes().len()], s.nodes());
         assert!(out.pts.len() > s.nodes().len(), "no interior point");
         let mut vol = 0.0;
@@ -594,7 +615,15 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mc_blob.off");
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
-        let out = whole_fill(s.nodes(), s.triangles(), &size).unwrap();
+        // The fill at crossings first, as the passes were measured on (with no flat
+        // tets first, example002's fill leaves the passes far less to do).
+        let out = whole_fill_trying(
+            s.nodes(),
+            s.triangles(),
+            &size,
+            &[Split::AtCrossing, Split::Halving],
+        )
+        .unwrap();
         let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles());
         let flat = out
             .tets
@@ -621,7 +650,15 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
-        let out = whole_fill(s.nodes(), s.triangles(), &size).unwrap();
+        // The fill at crossings first, as the passes were measured on (with no flat
+        // tets first, example002's fill leaves the passes far less to do).
+        let out = whole_fill_trying(
+            s.nodes(),
+            s.triangles(),
+            &size,
+            &[Split::AtCrossing, Split::Halving],
+        )
+        .unwrap();
         let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles())
             .with_sliver_floors(s.nodes(), s.triangles());
         let (pts, tets, _) = improve_linear(out.pts, out.tets, &bnd, prm);
