@@ -407,21 +407,20 @@ mod tests {
     use crate::Options;
     use std::collections::HashMap;
 
-    /// The whole fill of a P2 surface: every tet positive, the boundary exactly the
-    /// input's corner triangles, the volume the enclosed one, interior points added.
-    fn check_whole_fill(path: &str) -> FrontOutput {
+    /// The surface in `path` (from the crate root) and its whole fill with the tries
+    /// `inside` with the points inside.
+    fn fill_file(path: &str, inside: &[Split]) -> (crate::Surface, FrontOutput) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
         let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
         let size = crate::generate::size_field(&s, &Options::default());
-        // The fill at crossings first, as the passes were measured on (with no flat
-        // tets first, example002's fill leaves the passes far less to do).
-        let out = whole_fill_trying(
-            s.nodes(),
-            s.triangles(),
-            &size,
-            &[Split::AtCrossing, Split::Halving],
-        )
-        .unwrap();
+        let out = whole_fill_trying(s.nodes(), s.triangles(), &size, inside).unwrap();
+        (s, out)
+    }
+
+    /// The whole fill of a P2 surface: every tet positive, the boundary exactly the
+    /// input's corner triangles, the volume the enclosed one, interior points added.
+    fn check_whole_fill(path: &str) -> FrontOutput {
+        let (s, out) = fill_file(path, INSIDE_TRIES);
         assert_eq!(&out.pts[..s.nodes().len()], s.nodes());
         assert!(out.pts.len() > s.nodes().len(), "no interior point");
         let mut vol = 0.0;
@@ -612,18 +611,7 @@ mod tests {
     #[test]
     fn lifting_removes_flat_tets_whose_corners_are_all_on_the_surface() {
         use crate::geom::tet_quality::dihedral_extremes;
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/mc_blob.off");
-        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-        let size = crate::generate::size_field(&s, &Options::default());
-        // The fill at crossings first, as the passes were measured on (with no flat
-        // tets first, example002's fill leaves the passes far less to do).
-        let out = whole_fill_trying(
-            s.nodes(),
-            s.triangles(),
-            &size,
-            &[Split::AtCrossing, Split::Halving],
-        )
-        .unwrap();
+        let (s, out) = fill_file("tests/data/mc_blob.off", INSIDE_TRIES);
         let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles());
         let flat = out
             .tets
@@ -647,18 +635,9 @@ mod tests {
         prm: &crate::optimize::LinearParams,
     ) -> (Vec<P3>, Vec<[u32; 4]>, crate::optimize::Boundary) {
         use crate::optimize::linear::improve_linear;
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
-        let s = crate::io::read_any_surface(&path, &Default::default()).unwrap();
-        let size = crate::generate::size_field(&s, &Options::default());
         // The fill at crossings first, as the passes were measured on (with no flat
         // tets first, example002's fill leaves the passes far less to do).
-        let out = whole_fill_trying(
-            s.nodes(),
-            s.triangles(),
-            &size,
-            &[Split::AtCrossing, Split::Halving],
-        )
-        .unwrap();
+        let (s, out) = fill_file(path, &[Split::AtCrossing, Split::Halving]);
         let bnd = crate::optimize::Boundary::new(s.nodes().len(), s.triangles())
             .with_sliver_floors(s.nodes(), s.triangles());
         let (pts, tets, _) = improve_linear(out.pts, out.tets, &bnd, prm);
