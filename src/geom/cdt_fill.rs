@@ -96,7 +96,10 @@ pub(crate) fn fill(
 /// The Delaunay tetrahedralization [`fill`] starts from, for [`fill_from`]: tries with
 /// other ways on the same points build it once.
 pub(crate) fn delaunay(pts: &[P3]) -> Delaunay {
-    Delaunay::new(pts)
+    let mut dt = Delaunay::new(pts);
+    // (Each try of the whole fill starts from a copy.)
+    dt.compact();
+    dt
 }
 
 /// [`fill`] from the Delaunay tetrahedralization of its points ([`delaunay`]);
@@ -792,6 +795,7 @@ impl<'a> Cdt<'a> {
             }
         }
         self.dt.rebuild_vt();
+        self.dt.compact();
         Ok(())
     }
 

@@ -690,6 +690,44 @@ impl Delaunay {
         out
     }
 
+    /// Drop the dead tets' slots, keeping the live tets in their order (so that every
+    /// walk, scan and choice by id afterwards goes as it would have without): ids are
+    /// never reused, and after the constrained fill's recovery and the outside's removal
+    /// nine slots in ten were dead (OpenSCAD's CSG-modules: 1.32M for 114k live tets),
+    /// which every scan over the tets then paid for. Faces across from a dead tet become
+    /// [`NONE`].
+    pub(crate) fn compact(&mut self) {
+        let mut new_id = vec![NONE; self.tets.len()];
+        let mut n = 0u32;
+        for (id, &alive) in new_id.iter_mut().zip(&self.alive) {
+            if alive {
+                *id = n;
+                n += 1;
+            }
+        }
+        let map = |t: u32| if t == NONE { NONE } else { new_id[t as usize] };
+        let mut w = 0;
+        for t in 0..self.tets.len() {
+            if self.alive[t] {
+                self.tets[w] = self.tets[t];
+                self.adj[w] = self.adj[t].map(map);
+                w += 1;
+            }
+        }
+        self.tets.truncate(w);
+        self.adj.truncate(w);
+        self.alive = vec![true; w];
+        for t in self.vt.iter_mut() {
+            *t = map(*t);
+        }
+        self.last = if map(self.last) != NONE {
+            map(self.last)
+        } else {
+            0
+        };
+        *self.walked.borrow_mut() = Stamps::default();
+    }
+
     /// Rebuild the point-to-tet map from the live tets (after tets are dropped).
     pub(crate) fn rebuild_vt(&mut self) {
         self.vt = vec![NONE; self.pts.len()];
@@ -1293,6 +1331,45 @@ mod tests {
             assert!(dt.positive(dt.tets[t]), "tet {t}");
         }
         assert!((volume(&dt) - v0).abs() <= 1e-9 * v0);
+    }
+
+    /// Compacting drops every dead slot, keeps the live tets in their order with their
+    /// links, and the insertions after it make the same tets (renumbered) as without.
+    #[test]
+    fn compacting_keeps_the_live_tets_in_order_and_what_follows() {
+        let mut s = 0x51f15e5u64;
+        let pts: Vec<P3> = (0..120)
+            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
+            .collect();
+        let live = |dt: &Delaunay| -> Vec<[u32; 4]> {
+            (0..dt.tets.len())
+                .filter(|&t| dt.alive[t])
+                .map(|t| dt.tets[t])
+                .collect()
+        };
+        let plain = Delaunay::new(&pts);
+        let mut packed = plain.clone();
+        packed.compact();
+        assert!(plain.alive.iter().any(|a| !a), "nothing to drop");
+        assert_eq!(packed.tets.len(), live(&plain).len());
+        assert!(packed.alive.iter().all(|&a| a));
+        assert_eq!(live(&packed), live(&plain));
+        check_delaunay(&packed);
+        for v in 0..pts.len() as u32 {
+            let star = packed.star(v);
+            assert!(!star.is_empty() && star.iter().all(|&t| packed.tets[t as usize].contains(&v)));
+            assert_eq!(star.len(), plain.star(v).len(), "point {v}");
+        }
+        let mut plain = plain;
+        for _ in 0..40 {
+            let q = [rng(&mut s), rng(&mut s), rng(&mut s)];
+            assert_eq!(
+                plain.insert_point(q).is_some(),
+                packed.insert_point(q).is_some()
+            );
+            assert_eq!(live(&packed), live(&plain));
+        }
+        check_delaunay(&packed);
     }
 
     #[test]
