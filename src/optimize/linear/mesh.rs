@@ -186,8 +186,10 @@ impl<'a> LinMesh<'a> {
     /// Whether an edge split that replaces tets scoring `old` by tets scoring `new`
     /// makes more unforced slivers than it removes: in the sliver passes, more tets
     /// scoring below 1. Lifting the minimum alone let the passes split one sliver into
-    /// several better ones, pass after pass. (Asked of the splits only: refusing flips,
-    /// contractions and vertex moves that make more left more slivers in the end.)
+    /// several better ones, pass after pass. (Asked of the splits and cavity insertions
+    /// only, and not where the slivers they replace are all stuck, see
+    /// `insert::only_stuck_slivers`: refusing flips, contractions and vertex moves that
+    /// make more left more slivers in the end.)
     pub fn more_unforced(
         &self,
         old: impl IntoIterator<Item = f64>,

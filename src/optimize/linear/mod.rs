@@ -598,7 +598,7 @@ fn sliver_rounds(
     let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
     // Goal and search threshold: a score of 1 (skewness 0 in the passes' terms);
     // no narrowing to the worst (a reach of 1 spans every score below the goal).
-    let p = LinearParams {
+    let mut p = LinearParams {
         goal_skewness: 0.0,
         search_skewness: 0.0,
         max_attempts_per_tet: spent + 2.0,
@@ -616,8 +616,12 @@ fn sliver_rounds(
     let mut passes = 0;
     // Once the rounds stop removing any, more rounds from the best mesh so far with
     // cavity insertions as a last resort: only then, so that the rounds before take
-    // the same path as without them (they make some parts end with more).
+    // the same path as without them (they make some parts end with more). Where some
+    // are left still, rounds from the best mesh again whose insertions may trade stuck
+    // slivers for more ([`InsertScratch::trade_stuck`]), with a budget of their own,
+    // kept only where they leave fewer.
     loop {
+        let mut stalled = 0;
         while left > 0 && passes < prm.sliver_passes && !sc.stopped() {
             let round = LinearParams {
                 max_passes: SLIVER_ROUND_PASSES.min(prm.sliver_passes - passes),
@@ -633,22 +637,32 @@ fn sliver_rounds(
             if now < best.0 {
                 best = (now, m.clone());
             }
-            if now >= left {
+            // (A trading round may go on after one that removed none: a trade makes more
+            // before the round after it lifts them.)
+            stalled = if now >= left { stalled + 1 } else { 0 };
+            if stalled > usize::from(sc.insert.trade_stuck) {
                 break;
             }
             left = now;
         }
-        if sc.cavities || best.0 == 0 || passes >= prm.sliver_passes || sc.stopped() {
+        if sc.insert.trade_stuck || best.0 == 0 || sc.stopped() {
             break;
         }
+        let trade = sc.cavities || passes >= prm.sliver_passes;
         if census(m, 1.0).1 > best.0 {
             *m = best.1.clone();
+        }
+        if trade {
+            sc.insert.trade_stuck = true;
+            passes = passes.min(prm.sliver_passes.saturating_sub(TRADE_PASSES));
+            p.max_attempts_per_tet = st.attempts as f64 / st.tets[0].max(1) as f64 + 1.0;
         }
         sc.cavities = true;
         failed.clear();
         left = best.0;
     }
     sc.cavities = false;
+    sc.insert.trade_stuck = false;
     if census(m, 1.0).1 > best.0 {
         *m = best.1;
     }
@@ -680,6 +694,10 @@ fn doomed_edges(m: &LinMesh) -> rustc_hash::FxHashSet<(u32, u32)> {
     }
     out
 }
+
+/// Passes of [`sliver_rounds`]' last rounds, those that trade stuck slivers
+/// ([`InsertScratch::trade_stuck`]), whatever the earlier rounds spent.
+const TRADE_PASSES: usize = 32;
 
 /// Most passes of a round of [`LinearParams::sliver_passes`] before its vertex searches.
 const SLIVER_ROUND_PASSES: usize = 8;
