@@ -92,7 +92,8 @@ pub struct LinearParams {
     /// the element quality, no longer block every move. Up to this many passes in all, in
     /// rounds of eight each followed by vertex searches, while a round removes some,
     /// with a budget of their own (two attempts per tet of the input); 0: none; the mesh
-    /// of the round that left the fewest is kept. Where some are left, the rounds run
+    /// of the round that left the fewest is kept. The last rounds, where some are left,
+    /// may trade stuck ones (every corner on the surface) for more, better ones. Where some are left, the rounds run
     /// again with edge splits that also search for their new vertex's position, from the
     /// start and from the end, and the run that leaves the fewest is kept. The rounds
     /// keep removing them slowly
