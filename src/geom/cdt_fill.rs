@@ -1808,13 +1808,18 @@ mod tests {
         fill_and_check_with(pts, outward, Split::AtCrossing)
     }
 
+    /// The triangles `outward` turned to face into the region, as the fill takes them.
+    fn inward(outward: &[[u32; 3]]) -> Vec<[u32; 3]> {
+        outward.iter().map(|f| [f[0], f[2], f[1]]).collect()
+    }
+
     /// [`fill_and_check`] with Steiner points placed by `split`.
     fn fill_and_check_with(
         pts: &[P3],
         outward: &[[u32; 3]],
         split: Split,
     ) -> Result<Filled, String> {
-        let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        let faces = inward(outward);
         let mut stages = Stages::default();
         let r = fill(pts, &faces, split, None, Patience::Exhaustive, &mut stages)
             .map_err(|e| e.to_string())?;
@@ -1987,7 +1992,7 @@ mod tests {
     #[test]
     fn contraction_removes_the_flat_tets_moving_off_leaves() {
         let (pts, outward) = openscad_corners("example018");
-        let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        let faces = inward(&outward);
         let mut c = Cdt::new(
             Delaunay::new(&pts),
             &faces,
@@ -2087,7 +2092,7 @@ mod tests {
     fn a_layer_coplanar_within_rounding_fills_without_flat_tets() {
         let (pts, outward) = surface_corners("tori/aniso_12x44.off");
         assert!(fill_and_check(&pts, &outward).is_err());
-        let faces: Vec<[u32; 3]> = outward.iter().map(|f| [f[0], f[2], f[1]]).collect();
+        let faces = inward(&outward);
         let mut c = Cdt::new(
             Delaunay::new(&pts),
             &faces,

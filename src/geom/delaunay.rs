@@ -720,11 +720,8 @@ impl Delaunay {
         for t in self.vt.iter_mut() {
             *t = map(*t);
         }
-        self.last = if map(self.last) != NONE {
-            map(self.last)
-        } else {
-            0
-        };
+        // (The walks' start: any live tet where the last made is gone.)
+        self.last = Some(map(self.last)).filter(|&t| t != NONE).unwrap_or(0);
         *self.walked.borrow_mut() = Stamps::default();
     }
 
@@ -1192,6 +1189,11 @@ mod tests {
         (*seed >> 11) as f64 / (1u64 << 53) as f64
     }
 
+    /// A point of the unit cube from `seed` (three [`rng`] draws).
+    fn point(seed: &mut u64) -> P3 {
+        [rng(seed), rng(seed), rng(seed)]
+    }
+
     #[test]
     fn stamps_start_each_set_empty_even_when_the_stamp_wraps() {
         let mut m = Stamps::default();
@@ -1265,9 +1267,7 @@ mod tests {
     #[test]
     fn random_points_give_an_empty_sphere_triangulation() {
         let mut s = 0x9e3779b97f4a7c15u64;
-        let pts: Vec<P3> = (0..200)
-            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
-            .collect();
+        let pts: Vec<P3> = (0..200).map(|_| point(&mut s)).collect();
         let dt = Delaunay::new(&pts);
         check_delaunay(&dt);
         assert!(dt.interior_tets().count() > 200);
@@ -1294,9 +1294,7 @@ mod tests {
     #[test]
     fn inserted_points_keep_the_triangulation_and_its_fixed_edges() {
         let mut s = 0x2545f4914f6cdd1du64;
-        let pts: Vec<P3> = (0..150)
-            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
-            .collect();
+        let pts: Vec<P3> = (0..150).map(|_| point(&mut s)).collect();
         let volume = |dt: &Delaunay| -> f64 {
             (0..dt.tets.len())
                 .filter(|&t| dt.alive[t])
@@ -1308,7 +1306,7 @@ mod tests {
         };
         let mut dt = Delaunay::new(&pts);
         for _ in 0..60 {
-            let q = [rng(&mut s), rng(&mut s), rng(&mut s)];
+            let q = point(&mut s);
             assert!(dt.insert_point(q).is_some());
         }
         check_delaunay(&dt);
@@ -1320,7 +1318,7 @@ mod tests {
         dt.fixed_edges.extend(fixed.iter().copied());
         let mut added = 0;
         for _ in 0..200 {
-            let q = [rng(&mut s), rng(&mut s), rng(&mut s)];
+            let q = point(&mut s);
             added += usize::from(dt.insert_point(q).is_some());
         }
         assert!(added > 150, "{added} of 200 inserted");
@@ -1338,9 +1336,7 @@ mod tests {
     #[test]
     fn compacting_keeps_the_live_tets_in_order_and_what_follows() {
         let mut s = 0x51f15e5u64;
-        let pts: Vec<P3> = (0..120)
-            .map(|_| [rng(&mut s), rng(&mut s), rng(&mut s)])
-            .collect();
+        let pts: Vec<P3> = (0..120).map(|_| point(&mut s)).collect();
         let live = |dt: &Delaunay| -> Vec<[u32; 4]> {
             (0..dt.tets.len())
                 .filter(|&t| dt.alive[t])
@@ -1362,7 +1358,7 @@ mod tests {
         }
         let mut plain = plain;
         for _ in 0..40 {
-            let q = [rng(&mut s), rng(&mut s), rng(&mut s)];
+            let q = point(&mut s);
             assert_eq!(
                 plain.insert_point(q).is_some(),
                 packed.insert_point(q).is_some()

@@ -142,13 +142,24 @@ pub(super) fn split_edge(
     let new_q = m.vt[np as usize].iter().map(|&t| m.q[t as usize]);
     if new_min > old_min + eps
         && (!guard || old_min < 0.0 || !more_slivers())
-        && ((s.trade_stuck && only_stuck_slivers(m, s))
-            || !m.more_unforced(s.old_q.iter().copied(), new_q))
+        && unforced_count_allowed(m, s, new_q)
     {
         return true;
     }
     undo(m, s);
     false
+}
+
+/// Whether an insertion replacing the tets `s.old` (scoring `s.old_q`) by tets scoring
+/// `new_q` keeps to the count of unforced slivers: no more than it removes
+/// ([`LinMesh::more_unforced`]), unless it trades stuck ones ([`only_stuck_slivers`],
+/// in the rounds that may, [`InsertScratch::trade_stuck`]).
+fn unforced_count_allowed(
+    m: &LinMesh,
+    s: &InsertScratch,
+    new_q: impl IntoIterator<Item = f64>,
+) -> bool {
+    (s.trade_stuck && only_stuck_slivers(m, s)) || !m.more_unforced(s.old_q.iter().copied(), new_q)
 }
 
 /// Whether the tets an insertion replaces (`s.old`, scoring `s.old_q`) include unforced
@@ -282,10 +293,7 @@ pub(super) fn insert_in_cavity(
         .map(|&x| m.q[x as usize])
         .fold(f64::INFINITY, f64::min);
     let new_q = star.iter().map(|&x| m.q[x as usize]);
-    if new_min > old_min + eps
-        && ((s.trade_stuck && only_stuck_slivers(m, s))
-            || !m.more_unforced(s.old_q.iter().copied(), new_q))
-    {
+    if new_min > old_min + eps && unforced_count_allowed(m, s, new_q) {
         return true;
     }
     undo(m, s);

@@ -93,11 +93,10 @@ pub struct LinearParams {
     /// rounds of eight each followed by vertex searches, while a round removes some,
     /// with a budget of their own (two attempts per tet of the input); 0: none; the mesh
     /// of the round that left the fewest is kept. The last rounds, where some are left,
-    /// may trade stuck ones (every corner on the surface) for more, better ones. Where some are left, the rounds run
-    /// again with edge splits that also search for their new vertex's position, from the
-    /// start and from the end, and the run that leaves the fewest is kept. The rounds
-    /// keep removing them slowly
-    /// on large fills: OpenSCAD's example019 went from 14,106 to 4,352, 2,979, 2,280,
+    /// may trade stuck ones (every corner on the surface) for more, better ones. Where
+    /// some are left, the rounds run again with edge splits that also search for their
+    /// new vertex's position, from the start and from the end, and the run that leaves
+    /// the fewest is kept. The rounds keep removing them slowly on large fills: OpenSCAD's example019 went from 14,106 to 4,352, 2,979, 2,280,
     /// 1,732, 1,415, 997, 946, 897 and 839 in ten rounds, then 845 (a cap of 40 passes
     /// stopped it at 1,415; the five rounds more took 8 s of its 63 s stage).
     pub sliver_passes: usize,
@@ -338,6 +337,14 @@ pub fn improve_linear_known(
     kept
 }
 
+impl LinearStats {
+    /// Attempts at bad tets so far per tet of the input (the unit of
+    /// [`LinearParams::max_attempts_per_tet`]).
+    fn attempts_per_tet(&self) -> f64 {
+        self.attempts as f64 / self.tets[0].max(1) as f64
+    }
+}
+
 /// The points, tets and stats of [`improve_linear_known`].
 type Improved = (Vec<P3>, Vec<[u32; 4]>, LinearStats);
 
@@ -407,7 +414,7 @@ fn linear_run(
     }
     st.seconds.searches = lap();
     if let Some(flat) = prm.flat_skewness {
-        let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
+        let spent = st.attempts_per_tet();
         let flat = LinearParams {
             goal_skewness: flat,
             max_attempts_per_tet: spent + 1.0,
@@ -596,7 +603,7 @@ fn sliver_rounds(
     st: &mut LinearStats,
     order: &mut Vec<(f64, u32, [u32; 4])>,
 ) -> usize {
-    let spent = st.attempts as f64 / st.tets[0].max(1) as f64;
+    let spent = st.attempts_per_tet();
     // Goal and search threshold: a score of 1 (skewness 0 in the passes' terms);
     // no narrowing to the worst (a reach of 1 spans every score below the goal).
     let mut p = LinearParams {
@@ -656,7 +663,7 @@ fn sliver_rounds(
         if trade {
             sc.insert.trade_stuck = true;
             passes = passes.min(prm.sliver_passes.saturating_sub(TRADE_PASSES));
-            p.max_attempts_per_tet = st.attempts as f64 / st.tets[0].max(1) as f64 + 1.0;
+            p.max_attempts_per_tet = st.attempts_per_tet() + 1.0;
         }
         sc.cavities = true;
         failed.clear();
