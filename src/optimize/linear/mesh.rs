@@ -29,6 +29,11 @@ pub(super) struct LinMesh<'a> {
     pub changed: Vec<u64>,
     /// Counts changes (tets added or removed, vertices moved).
     pub clock: u64,
+    /// Per point: the [`LinMesh::clock`] value when a sampled search last failed to
+    /// move it (0: never, or moved since). The search is a function of the star's
+    /// corners and of the score, so while [`LinMesh::changed`] is older it fails again
+    /// (see [`LinMesh::search_futile`]).
+    searched: Vec<u64>,
     /// Deleted slots, reused by [`LinMesh::add`] (last freed first).
     free: Vec<u32>,
     /// Score tets by [`LinMesh::sliver_score`] instead of the element quality (the
@@ -85,6 +90,7 @@ impl<'a> LinMesh<'a> {
             dirty: vec![true; 0],
             changed: Vec::new(),
             clock: 1,
+            searched: Vec::new(),
             free: Vec::new(),
             sliver_mode: false,
             chorded: Default::default(),
@@ -161,8 +167,10 @@ impl<'a> LinMesh<'a> {
     /// on; every cached quality is measured again.
     pub fn set_sliver_mode(&mut self, on: bool) {
         self.sliver_mode = on;
-        // Smoothed to a standstill under the other measure is not under this one.
+        // Smoothed to a standstill, or searched in vain, under the other measure is not
+        // under this one.
         self.dirty.iter_mut().for_each(|d| *d = true);
+        self.searched.clear();
         for i in 0..self.tets.len() {
             if self.alive(i as u32) {
                 self.q[i] = self.quality(self.tets[i]);
@@ -247,6 +255,22 @@ impl<'a> LinMesh<'a> {
         self.tets[t as usize] = DEAD;
         self.q[t as usize] = f64::INFINITY;
         self.free.push(t);
+    }
+
+    /// Whether a sampled search for `v` failed since anything in its star last changed
+    /// (corners, tets, or the score): it would fail again.
+    pub fn search_futile(&self, v: u32) -> bool {
+        let s = self.searched.get(v as usize).copied().unwrap_or(0);
+        s != 0 && self.changed[v as usize] < s
+    }
+
+    /// Record that a sampled search failed to move `v`.
+    pub fn search_failed(&mut self, v: u32) {
+        if self.searched.len() <= v as usize {
+            self.searched.resize(self.pts.len(), 0);
+        }
+        self.clock += 1;
+        self.searched[v as usize] = self.clock;
     }
 
     /// Mark every corner of the star of `v` dirty (after `v` moved).

@@ -799,12 +799,14 @@ fn search_worst(
             break;
         }
         for &v in &tv {
-            if m.tets[t as usize] == tv
-                && m.q[t as usize] < floor
-                && search_vertex(m, v, &mut sc.smooth)
-            {
+            if m.tets[t as usize] != tv || m.q[t as usize] >= floor || m.search_futile(v) {
+                continue;
+            }
+            if search_vertex(m, v, &mut sc.smooth) {
                 st.searches += 1;
                 moved = true;
+            } else {
+                m.search_failed(v);
             }
         }
     }
@@ -1041,6 +1043,45 @@ mod tests {
         let mut m = LinMesh::new(pts, tets, &bnd, ElementQuality);
         assert!(!search_vertex(&mut m, 12, &mut sc));
         assert_eq!(m.pts[12], [0.0; 3]);
+    }
+
+    /// A vertex whose search failed is not searched again until its star changes (the
+    /// search would fail again: it depends on the star's corners and the score only).
+    #[test]
+    fn a_failed_search_waits_for_a_change_in_the_star() {
+        let bnd = Boundary::new(12, &[]);
+        let (pts, tets) = icosahedron_star([0.0; 3]);
+        let mut m = LinMesh::new(pts, tets, &bnd, ElementQuality);
+        let mut sc = Scratch::default();
+        let mut st = LinearStats::default();
+        // Every tet of the centred star counts as poor, and none can be lifted.
+        let prm = LinearParams {
+            search_skewness: 0.0,
+            ..LinearParams::default()
+        };
+        assert!(!m.search_futile(12));
+        assert!(!search_worst(
+            &mut m,
+            &prm,
+            &mut sc,
+            &mut st,
+            &mut Vec::new()
+        ));
+        assert!(m.search_futile(12));
+        // A corner of its star moves: worth a search again.
+        m.touch_star(0);
+        assert!(!m.search_futile(12));
+        assert!(!search_worst(
+            &mut m,
+            &prm,
+            &mut sc,
+            &mut st,
+            &mut Vec::new()
+        ));
+        assert!(m.search_futile(12));
+        // The score changes: worth a search again.
+        m.set_sliver_mode(true);
+        assert!(!m.search_futile(12));
     }
 
     #[test]
