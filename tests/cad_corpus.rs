@@ -332,7 +332,7 @@ corpus_parts! {
     geb_meshes: "GEB", 5_724, 4;
     children_meshes: "children", 8_888, 0;
     children_indexed_meshes: "children_indexed", 6_650, 0;
-    example005_meshes: "example005", 1_042, 4;
+    example005_meshes: "example005", 1_042, 3;
     example006_meshes: "example006", 11_884, 0;
     example007_meshes: "example007", 524, 0;
     example009_meshes: "example009", 1_640, 0;
@@ -340,13 +340,13 @@ corpus_parts! {
     example012_meshes: "example012", 916, 2;
     example018_meshes: "example018", 4_960, 0;
     example019_meshes: "example019", 3_912, 1;
-    example020_meshes: "example020", 8_490, 17;
+    example020_meshes: "example020", 8_490, 14;
     example021_meshes: "example021", 1_280, 0;
     example023_meshes: "example023", 3_028, 0;
     example024_meshes: "example024", 12_012, 0;
     linear_extrude_meshes: "linear_extrude", 1_690, 0;
     logo_meshes: "logo", 8_120, 0;
-    logo_and_text_meshes: "logo_and_text", 14_792, 6;
+    logo_and_text_meshes: "logo_and_text", 14_792, 0;
     projection_meshes: "projection", 1_112, 0;
     rotate_extrude_meshes: "rotate_extrude", 9_200, 0;
     sign_meshes: "sign", 3_268, 0;
