@@ -88,17 +88,19 @@ pub struct LinearParams {
     /// Last: passes and vertex searches aimed at the unforced slivers only (tets with a
     /// dihedral angle below [`crate::mesh::slivers::SLIVER_DEG`] that no needle or cap
     /// triangle at their corners forces; see [`Boundary::sliver_floor`]), scoring every
-    /// other tet as good (a score of 1), so that the forced slivers beside them, worse by
-    /// the element quality, no longer block every move. Up to this many passes in all, in
-    /// rounds of eight each followed by vertex searches, while a round removes some,
-    /// with a budget of their own (two attempts per tet of the input); 0: none; the mesh
-    /// of the round that left the fewest is kept. The last rounds, where some are left,
-    /// may trade stuck ones (every corner on the surface) for more, better ones. Where
+    /// other tet as good (a score of 1), so that the forced slivers beside them, worse
+    /// by the element quality, no longer block every move. Up to this many passes in
+    /// all, in rounds of eight each followed by vertex searches, while a round removes
+    /// some, with a budget of their own (two attempts per tet of the input); 0: none;
+    /// the mesh of the round that left the fewest is kept. The last rounds, where some
+    /// are left, may trade stuck ones (every corner on the surface) for more, better
+    /// ones (any ones in the runs whose cavities grow, the third and fourth). Where
     /// some are left, the rounds run again with edge splits that also search for their
     /// new vertex's position, from the start and from the end, and the run that leaves
-    /// the fewest is kept. The rounds keep removing them slowly on large fills: OpenSCAD's example019 went from 14,106 to 4,352, 2,979, 2,280,
-    /// 1,732, 1,415, 997, 946, 897 and 839 in ten rounds, then 845 (a cap of 40 passes
-    /// stopped it at 1,415; the five rounds more took 8 s of its 63 s stage).
+    /// the fewest is kept. The rounds keep removing them slowly on large fills:
+    /// OpenSCAD's example019 went from 14,106 to 4,352, 2,979, 2,280, 1,732, 1,415,
+    /// 997, 946, 897 and 839 in ten rounds, then 845 (a cap of 40 passes stopped it at
+    /// 1,415; the five rounds more took 8 s of its 63 s stage).
     pub sliver_passes: usize,
     /// The surface's boundary edges may go back on their chords (a surface curved from
     /// a linear one, `Surface::chords_allowed`): the straightening after the
