@@ -30,9 +30,9 @@ pub(super) struct LinMesh<'a> {
     /// Counts changes (tets added or removed, vertices moved).
     pub clock: u64,
     /// Per point: the [`LinMesh::clock`] value when a sampled search last failed to
-    /// move it (0: never, or moved since). The search is a function of the star's
-    /// corners and of the score, so while [`LinMesh::changed`] is older it fails again
-    /// (see [`LinMesh::search_futile`]).
+    /// move it (0: never). The search is a function of the star's corners and of the
+    /// score, so while [`LinMesh::changed`] is older it fails again (see
+    /// [`LinMesh::search_futile`]).
     searched: Vec<u64>,
     /// Deleted slots, reused by [`LinMesh::add`] (last freed first).
     free: Vec<u32>,

@@ -1119,25 +1119,14 @@ mod tests {
             search_skewness: 0.0,
             ..LinearParams::default()
         };
+        let mut search = |m: &mut LinMesh| search_worst(m, &prm, &mut sc, &mut st, &mut Vec::new());
         assert!(!m.search_futile(12));
-        assert!(!search_worst(
-            &mut m,
-            &prm,
-            &mut sc,
-            &mut st,
-            &mut Vec::new()
-        ));
+        assert!(!search(&mut m));
         assert!(m.search_futile(12));
         // A corner of its star moves: worth a search again.
         m.touch_star(0);
         assert!(!m.search_futile(12));
-        assert!(!search_worst(
-            &mut m,
-            &prm,
-            &mut sc,
-            &mut st,
-            &mut Vec::new()
-        ));
+        assert!(!search(&mut m));
         assert!(m.search_futile(12));
         // The score changes: worth a search again.
         m.set_sliver_mode(true);
