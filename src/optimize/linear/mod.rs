@@ -1068,41 +1068,42 @@ mod tests {
         assert_eq!(m.pts[12], [0.0; 3]);
     }
 
-    /// The sliver rounds count what the sliver census will: a tet of a cube bulged so
-    /// far that its curved boundary makes it P2-invalid (scored ≤ 0) is no sliver by its
-    /// corners' angles, and one whose corner moved into a face is.
+    /// The sliver rounds count what the sliver census ([`crate::mesh::slivers::census`])
+    /// will count on the assembled mesh: a tet of a cube bulged so far that its curved
+    /// boundary makes it P2-invalid (scored ≤ 0) is no sliver by its corners' angles, and
+    /// one whose corner moved almost onto its opposite face is.
     #[test]
-    fn the_rounds_count_slivers_by_their_corners_not_their_score() {
-        use crate::geom::tet_quality::dihedral_extremes;
+    fn the_rounds_count_slivers_as_the_census_does() {
         let c = crate::optimize::testmesh::cube(3, 0.6);
         let bnd = c.boundary();
-        let mut m = LinMesh::new(c.pts.clone(), c.tets.clone(), &bnd, ElementQuality);
-        m.set_sliver_mode(true);
-        let (_, below) = census(&m, 1.0);
+        let counts = |pts: Vec<P3>| {
+            let tm = crate::mesh::build::assemble(&pts, &c.tets, c.n_surf, &c.tris, &[]);
+            let mut m = LinMesh::new(pts, c.tets.clone(), &bnd, ElementQuality);
+            m.set_sliver_mode(true);
+            let census_unforced = crate::mesh::slivers::census(&tm).unforced;
+            (unforced_left(&m), census_unforced, census(&m, 1.0).1)
+        };
+        let (left, unforced, below) = counts(c.pts.clone());
         assert!(below > 0, "no P2-invalid tet at this bulge");
-        assert_eq!(unforced_left(&m), 0);
-        // An interior vertex moved almost onto the opposite face of a tet in its star: that
-        // tet becomes flat, and slivers count wherever the census would put them.
-        let v = (c.n_surf..c.pts.len()).next().expect("an interior vertex") as u32;
-        let t = m.vt[v as usize][0];
-        let f: Vec<u32> = m.tets[t as usize].into_iter().filter(|&x| x != v).collect();
-        let (q, o) = (m.pts[v as usize], m.pts.clone());
-        let mut pts = o.clone();
-        pts[v as usize] = std::array::from_fn(|k| {
-            let centroid = f.iter().map(|&x| o[x as usize][k]).sum::<f64>() / 3.0;
-            0.99 * centroid + 0.01 * q[k]
+        assert_eq!((left, unforced), (0, 0));
+        // An interior vertex moved almost onto the opposite face of a tet in its star
+        // (it stays inside that tet: every tet stays positive).
+        let m = LinMesh::new(c.pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+        let v = c.n_surf;
+        let t = m.vt[v][0];
+        let f: Vec<u32> = m.tets[t as usize]
+            .into_iter()
+            .filter(|&x| x != v as u32)
+            .collect();
+        let mut pts = c.pts.clone();
+        pts[v] = std::array::from_fn(|k| {
+            let centroid = f.iter().map(|&x| c.pts[x as usize][k]).sum::<f64>() / 3.0;
+            0.99 * centroid + 0.01 * c.pts[v][k]
         });
-        let mut m = LinMesh::new(pts, c.tets.clone(), &bnd, ElementQuality);
-        m.set_sliver_mode(true);
-        let expected = (0..m.tets.len())
-            .filter(|&t| {
-                let tv = m.tets[t];
-                dihedral_extremes(&m.corners(tv)).0 < bnd.tet_sliver_floor(tv)
-            })
-            .count();
-        assert!(expected > 0);
-        assert_eq!(unforced_left(&m), expected);
-        assert!(census(&m, 1.0).1 > expected);
+        let (left, unforced, below) = counts(pts);
+        assert!(unforced > 0);
+        assert_eq!(left, unforced);
+        assert!(below > unforced);
     }
 
     /// A vertex whose search failed is not searched again until its star changes (the
