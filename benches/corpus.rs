@@ -9,7 +9,10 @@
 //! - curvetet: `curvetet mesh IN -o OUT.vtu --report R.json -q` with default options, killed
 //!   after `--timeout` seconds (default 60); wall time, tets, minimum dihedral angle,
 //!   certified min J / max J, and the sliver counts of the report when it has them;
-//! - TetGen:   `tetgen -pYqQ IN` (quality mesh, boundary kept) on the same file.
+//! - TetGen:   `tetgen -pYqQ IN` (quality mesh, boundary kept) on the same file; its
+//!   mesh's tets, smallest dihedral angle and sliver census (forced / unforced, by
+//!   curvetet's own census against the same triangles), so that the times compare meshes
+//!   whose quality the table shows.
 //!
 //! Prints a table, the count meshed, the total time ratio (over the surfaces both meshed,
 //! and with failures counted at their time) and the worst per-surface ratio. The issue's
@@ -92,6 +95,76 @@ struct Row {
     slivers_unforced: Option<u64>,
     tg_secs: f64,
     tg_ok: bool,
+    /// TetGen's mesh, measured as curvetet's is (corner tets; the sliver census against
+    /// its boundary triangles, which `-Y` keeps as the input's).
+    tg_tets: usize,
+    tg_min_dihedral: f64,
+    tg_slivers_forced: Option<usize>,
+    tg_slivers_unforced: Option<usize>,
+}
+
+/// Tets, smallest dihedral angle and sliver census of the mesh TetGen wrote at `base`
+/// (`base.1.node`, `.1.ele`, `.1.face`); None where a file is missing or malformed.
+fn tetgen_quality(base: &Path) -> Option<(usize, f64, curvetet::SliverCensus)> {
+    let read = |ext: &str| std::fs::read_to_string(base.with_extension(ext)).ok();
+    // Each file: a header line, then one line per item, `#` comments skipped; items are
+    // numbered from the `.node` file's first index.
+    let rows = |text: &str| -> Vec<Vec<f64>> {
+        text.lines()
+            .map(|l| l.split('#').next().unwrap_or(""))
+            .filter(|l| !l.trim().is_empty())
+            .skip(1)
+            .map(|l| {
+                l.split_whitespace()
+                    .filter_map(|x| x.parse().ok())
+                    .collect()
+            })
+            .collect()
+    };
+    let nodes = rows(&read("1.node")?);
+    let first = nodes.first()?.first().copied()? as u32;
+    let pts: Vec<[f64; 3]> = nodes
+        .iter()
+        .map(|r| (r.len() >= 4).then(|| [r[1], r[2], r[3]]))
+        .collect::<Option<_>>()?;
+    let n = pts.len();
+    let index = |x: f64| -> Option<u32> {
+        let i = (x as u32).checked_sub(first)?;
+        ((i as usize) < n).then_some(i)
+    };
+    let mut mesh = curvetet::TetMesh {
+        nodes: pts,
+        ..Default::default()
+    };
+    for r in rows(&read("1.ele")?) {
+        let c: Vec<u32> = r
+            .get(1..5)?
+            .iter()
+            .map(|&x| index(x))
+            .collect::<Option<_>>()?;
+        mesh.tets.push([c[0], c[1], c[2], c[3], 0, 0, 0, 0, 0, 0]);
+    }
+    for r in rows(&read("1.face")?) {
+        let c: Vec<u32> = r
+            .get(1..4)?
+            .iter()
+            .map(|&x| index(x))
+            .collect::<Option<_>>()?;
+        mesh.boundary.push([c[0], c[1], c[2], 0, 0, 0]);
+    }
+    let min_dihedral = mesh
+        .tets
+        .iter()
+        .map(|t| {
+            let c = [t[0], t[1], t[2], t[3]].map(|v| mesh.nodes[v as usize]);
+            curvetet::geom::tet_quality::dihedral_extremes(&c).0
+        })
+        .fold(f64::INFINITY, f64::min);
+    Some((
+        mesh.tets.len(),
+        min_dihedral,
+        curvetet::mesh::slivers::census(&mesh),
+    ))
 }
 
 /// The largest curvetet time / (10 x TetGen's + 0.5 s) among `rows`, and its surface.
@@ -147,7 +220,7 @@ fn main() {
         );
     }
     println!(
-        "{:<22} {:>6} {:>9} {:>8} {:>7} {:>7} {:>8} {:>9} {:>7} {:>6}",
+        "{:<22} {:>6} {:>9} {:>8} {:>7} {:>7} {:>8} {:>9} {:>7} {:>6} {:>7} {:>7} {:>10}",
         "surface",
         "tris",
         "curvetet",
@@ -157,7 +230,10 @@ fn main() {
         "min J",
         "slivers",
         "TetGen",
-        "ratio"
+        "ratio",
+        "TG tets",
+        "TG dih",
+        "TG slivers"
     );
     let mut rows = Vec::new();
     for f in &files {
@@ -214,13 +290,27 @@ fn main() {
             );
             r.tg_secs = t;
             r.tg_ok = code == Some(0);
+            if let Some((tets, min_dih, census)) = tetgen_quality(&off).filter(|_| r.tg_ok) {
+                r.tg_tets = tets;
+                r.tg_min_dihedral = min_dih;
+                r.tg_slivers_forced = Some(census.forced);
+                r.tg_slivers_unforced = Some(census.unforced);
+            }
         }
         let sl = match (r.slivers_forced, r.slivers_unforced) {
             (Some(fo), Some(un)) => format!("{fo}/{un}"),
             _ => "-".into(),
         };
+        let (tg_tets, tg_dih, tg_sl) = match (r.tg_slivers_forced, r.tg_slivers_unforced) {
+            (Some(fo), Some(un)) => (
+                r.tg_tets.to_string(),
+                format!("{:.2}", r.tg_min_dihedral),
+                format!("{fo}/{un}"),
+            ),
+            _ => ("-".into(), "-".into(), "-".into()),
+        };
         println!(
-            "{:<22} {:>6} {:>9.2} {:>8} {:>7} {:>7.2} {:>8.3} {:>9} {:>7.2} {:>6.1}",
+            "{:<22} {:>6} {:>9.2} {:>8} {:>7} {:>7.2} {:>8.3} {:>9} {:>7.2} {:>6.1} {:>7} {:>7} {:>10}",
             r.name,
             r.triangles,
             r.ct_secs,
@@ -230,7 +320,10 @@ fn main() {
             r.min_jac,
             sl,
             r.tg_secs,
-            r.ct_secs / r.tg_secs.max(1e-3)
+            r.ct_secs / r.tg_secs.max(1e-3),
+            tg_tets,
+            tg_dih,
+            tg_sl
         );
         if have_tetgen && !r.tg_ok {
             println!("  (TetGen failed on {name})");
@@ -245,6 +338,7 @@ fn main() {
     // meshed too.
     let worst_tg = worst_ratio(rows.iter().filter(|r| r.tg_ok));
     let unforced: u64 = rows.iter().filter_map(|r| r.slivers_unforced).sum();
+    let tg_unforced: usize = rows.iter().filter_map(|r| r.tg_slivers_unforced).sum();
     if !have_tetgen {
         println!(
             "meshed {ok} of {}; total {total_ct:.1} s; unforced slivers {unforced}",
@@ -254,7 +348,7 @@ fn main() {
         println!(
         "meshed {ok} of {}; total {total_ct:.1} s vs TetGen {total_tg:.1} s (ratio {:.1}, target <= 3); \
          worst time / (10 x TetGen + 0.5 s) = {:.2} ({}; target <= 1), {:.2} ({}) where TetGen \
-         meshed; unforced slivers {unforced}",
+         meshed; unforced slivers {unforced} (TetGen's meshes: {tg_unforced})",
         rows.len(),
         total_ct / total_tg.max(1e-3),
         worst.0,
