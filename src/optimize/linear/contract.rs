@@ -77,13 +77,10 @@ fn common<T: Ord>(a: &[T], b: &[T]) -> usize {
     n
 }
 
-/// Try contracting the edge (r, k), removing the interior vertex `r`. Returns true when
-/// applied.
-pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut ContractScratch) -> bool {
-    if m.bnd.is_fixed(r) {
-        return false;
-    }
-    // Link condition: Lk(r) ∩ Lk(k) = Lk(rk) (triangles, edges, vertices).
+/// Whether (r, k) is an edge that meets the link condition, Lk(r) ∩ Lk(k) = Lk(rk)
+/// (triangles, edges, vertices): merging `r` into `k` then keeps the mesh a manifold
+/// (whether every new tet is positive is for the caller to check).
+fn linkable(m: &LinMesh, r: u32, k: u32, s: &mut ContractScratch) -> bool {
     link(m, r, &mut s.link_r, &mut s.edges_r, &mut s.verts_r);
     link(m, k, &mut s.link_k, &mut s.edges_k, &mut s.verts_k);
     s.ring_e.clear();
@@ -110,10 +107,59 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
     s.ring_e.dedup();
     s.ring_v.sort_unstable();
     s.ring_v.dedup();
-    if common(&s.link_r, &s.link_k) != 0
-        || common(&s.edges_r, &s.edges_k) != s.ring_e.len()
-        || common(&s.verts_r, &s.verts_k) != s.ring_v.len()
-    {
+    common(&s.link_r, &s.link_k) == 0
+        && common(&s.edges_r, &s.edges_k) == s.ring_e.len()
+        && common(&s.verts_r, &s.verts_k) == s.ring_v.len()
+}
+
+/// In the sliver passes: merge the interior vertex `r` into its neighbour `k`, which
+/// stays where it is, where that leaves fewer unforced slivers ([`LinMesh::unforced`])
+/// among the tets that change (the star of `r`; no other tet changes) and every new tet
+/// scores above 0 (positive, and valid as a P2 element). Returns true when applied.
+pub(super) fn contract_fewer(m: &mut LinMesh, r: u32, k: u32, s: &mut ContractScratch) -> bool {
+    if m.bnd.is_fixed(r) || !linkable(m, r, k, s) {
+        return false;
+    }
+    let star = &m.vt[r as usize];
+    if star.iter().any(|&t| m.exempt(t)) {
+        return false;
+    }
+    let before = star
+        .iter()
+        .filter(|&&t| m.unforced(m.tets[t as usize], m.q[t as usize]))
+        .count();
+    s.touched.clear();
+    s.touched.extend_from_slice(star);
+    s.new_tets.clear();
+    let mut after = 0;
+    for &t in &s.touched {
+        let tv = m.tets[t as usize];
+        if tv.contains(&k) {
+            continue;
+        }
+        let nv = tv.map(|x| if x == r { k } else { x });
+        let q = m.quality(nv);
+        after += usize::from(m.unforced(nv, q));
+        if q <= 0.0 || after >= before {
+            return false;
+        }
+        s.new_tets.push(nv);
+    }
+    for &t in &s.touched {
+        m.remove(t);
+    }
+    for i in 0..s.new_tets.len() {
+        let v = s.new_tets[i];
+        let q = m.quality(v);
+        m.add(v, q);
+    }
+    true
+}
+
+/// Try contracting the edge (r, k), removing the interior vertex `r`. Returns true when
+/// applied.
+pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut ContractScratch) -> bool {
+    if m.bnd.is_fixed(r) || !linkable(m, r, k, s) {
         return false;
     }
     // Tets touched: star(r) ∪ star(k).

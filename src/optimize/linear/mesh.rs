@@ -214,6 +214,20 @@ impl<'a> LinMesh<'a> {
         self.sliver_mode
     }
 
+    /// In the sliver passes, whether the tet on corners `v` scoring `q` is an unforced
+    /// sliver as the sliver census will count it (a corner dihedral angle below the
+    /// tet's floor, [`Boundary::tet_sliver_floor`]): a score in (0, 1) says so; a score
+    /// ≤ 0 (inverted, flat or not valid as a P2 element) leaves it to the corners'
+    /// angles, since the straightening after the high-order stage makes a P2-invalid tet
+    /// valid without moving a corner.
+    pub fn unforced(&self, v: [u32; 4], q: f64) -> bool {
+        q < 1.0
+            && (q > 0.0 || {
+                crate::geom::tet_quality::dihedral_extremes(&self.corners(v)).0
+                    < self.bnd.tet_sliver_floor(v)
+            })
+    }
+
     /// True for a live tet slot.
     #[inline]
     pub fn alive(&self, t: u32) -> bool {
