@@ -340,7 +340,7 @@ corpus_parts! {
     example012_meshes: "example012", 916, 2;
     example018_meshes: "example018", 4_960, 0;
     example019_meshes: "example019", 3_912, 1;
-    example020_meshes: "example020", 8_490, 11;
+    example020_meshes: "example020", 8_490, 8;
     example021_meshes: "example021", 1_280, 0;
     example023_meshes: "example023", 3_028, 0;
     example024_meshes: "example024", 12_012, 0;

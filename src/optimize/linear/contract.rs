@@ -5,6 +5,7 @@
 //! quality of the touched tets must rise.
 
 use super::mesh::LinMesh;
+use crate::geom::tet_quality::positive_and_not_flat;
 use crate::geom::vec3::{mid, P3};
 
 /// Scratch buffers of the contraction.
@@ -115,15 +116,23 @@ fn linkable(m: &LinMesh, r: u32, k: u32, s: &mut ContractScratch) -> bool {
 /// In the sliver passes: merge the interior vertex `r` into its neighbour `k`, which
 /// stays where it is, where that leaves fewer unforced slivers ([`LinMesh::unforced`])
 /// among the tets that change (the star of `r`; no other tet changes) and every new tet
-/// scores above 0 (positive, and valid as a P2 element). Returns true when applied.
-pub(super) fn contract_fewer(m: &mut LinMesh, r: u32, k: u32, s: &mut ContractScratch) -> bool {
+/// scores above 0 (positive, and valid as a P2 element), or, with `chords` (a surface
+/// curved from a linear one, whose curved boundary edges the straightening after the
+/// high-order stage may put on their chords: [`super::LinearParams::chords`]), is a
+/// positive straight tet that is not numerically flat. Returns true when applied.
+pub(super) fn contract_fewer(
+    m: &mut LinMesh,
+    r: u32,
+    k: u32,
+    chords: bool,
+    s: &mut ContractScratch,
+) -> bool {
     if m.bnd.is_fixed(r) || !linkable(m, r, k, s) {
         return false;
     }
+    // (A tet of the star that is not valid as a P2 element, which the sliver passes
+    // otherwise leave alone, either goes with the edge (r, k) or must come out valid.)
     let star = &m.vt[r as usize];
-    if star.iter().any(|&t| m.exempt(t)) {
-        return false;
-    }
     let before = star
         .iter()
         .filter(|&&t| m.unforced(m.tets[t as usize], m.q[t as usize]))
@@ -140,7 +149,8 @@ pub(super) fn contract_fewer(m: &mut LinMesh, r: u32, k: u32, s: &mut ContractSc
         let nv = tv.map(|x| if x == r { k } else { x });
         let q = m.quality(nv);
         after += usize::from(m.unforced(nv, q));
-        if q <= 0.0 || after >= before {
+        let valid = q > 0.0 || (chords && positive_and_not_flat(&m.corners(nv)));
+        if !valid || after >= before {
             return false;
         }
         s.new_tets.push(nv);

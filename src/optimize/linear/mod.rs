@@ -556,7 +556,7 @@ fn unforced_sliver_passes(
     }
     sc.face_removal = every_pass;
     if unforced_left(m) > 0 {
-        contract_leftovers(m, &mut sc.contract);
+        contract_leftovers(m, prm.chords, &mut sc.contract);
     }
     let left = unforced_left(m);
     m.chorded.clear();
@@ -576,7 +576,7 @@ const LEFTOVER_ROUNDS: usize = 4;
 /// pocket between needle faces (three slivers around it, its star of ten tets) is then
 /// left where no move lifts them. Only the count decides here, and only a merge that
 /// lowers it is made: the stage never ends with more.
-fn contract_leftovers(m: &mut LinMesh, sc: &mut ContractScratch) {
+fn contract_leftovers(m: &mut LinMesh, chords: bool, sc: &mut ContractScratch) {
     for _ in 0..LEFTOVER_ROUNDS {
         let slivers: Vec<[u32; 4]> = (0..m.tets.len())
             .filter(|&t| m.alive(t as u32) && m.unforced(m.tets[t], m.q[t]))
@@ -597,7 +597,7 @@ fn contract_leftovers(m: &mut LinMesh, sc: &mut ContractScratch) {
                 around.dedup();
                 if around
                     .into_iter()
-                    .any(|k| contract::contract_fewer(m, r, k, sc))
+                    .any(|k| contract::contract_fewer(m, r, k, chords, sc))
                 {
                     merged = true;
                 }
@@ -1182,7 +1182,7 @@ mod tests {
             })
             .collect();
         for &(r, k) in &pairs {
-            assert!(!contract::contract_fewer(&mut m, r, k, &mut sc));
+            assert!(!contract::contract_fewer(&mut m, r, k, false, &mut sc));
         }
         let mut merged = 0;
         for &(r, k) in &pairs {
@@ -1195,9 +1195,9 @@ mod tests {
             let v0 = volume(&m);
             if bnd.is_fixed(k) {
                 // A boundary vertex is never merged away.
-                assert!(!contract::contract_fewer(&mut m, k, r, &mut sc));
+                assert!(!contract::contract_fewer(&mut m, k, r, false, &mut sc));
             }
-            if !contract::contract_fewer(&mut m, r, k, &mut sc) {
+            if !contract::contract_fewer(&mut m, r, k, false, &mut sc) {
                 continue;
             }
             merged += 1;
@@ -1211,6 +1211,63 @@ mod tests {
             assert!((volume(&m) - v0).abs() < 1e-12 * v0.abs());
         }
         assert!(merged > 0, "no merge among {} pairs", pairs.len());
+    }
+
+    /// On a curved boundary, a merge whose new tets include one that is not valid as a
+    /// P2 element is refused, unless the boundary edges may be put on their chords
+    /// (a surface curved from a linear one): then the straight tet is what counts.
+    #[test]
+    fn a_merge_may_leave_a_tet_for_the_straightening_only_where_chords_are_allowed() {
+        let c = crate::optimize::testmesh::cube(3, 0.6);
+        let bnd = c.boundary();
+        let m0 = LinMesh::new(c.pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+        let mut sc = ContractScratch::default();
+        let mut both = 0;
+        for r in (0..c.pts.len() as u32).filter(|&r| !bnd.is_fixed(r)) {
+            let mut ks: Vec<u32> = m0.vt[r as usize]
+                .iter()
+                .flat_map(|&t| m0.tets[t as usize])
+                .filter(|&x| x != r && bnd.is_fixed(x))
+                .collect();
+            ks.sort_unstable();
+            ks.dedup();
+            for k in ks {
+                let mut pts = c.pts.clone();
+                pts[r as usize] = std::array::from_fn(|d| {
+                    0.97 * c.pts[k as usize][d] + 0.03 * c.pts[r as usize][d]
+                });
+                let fresh = || {
+                    let mut m = LinMesh::new(pts.clone(), c.tets.clone(), &bnd, ElementQuality);
+                    m.set_sliver_mode(true);
+                    m
+                };
+                let (mut plain, mut chorded) = (fresh(), fresh());
+                let before = unforced_left(&plain);
+                let a = contract::contract_fewer(&mut plain, r, k, false, &mut sc);
+                let b = contract::contract_fewer(&mut chorded, r, k, true, &mut sc);
+                // Whatever chords allow, a merge leaves fewer, and every tet positive.
+                for (m, applied) in [(&plain, a), (&chorded, b)] {
+                    if applied {
+                        assert!(unforced_left(m) < before);
+                        for t in (0..m.tets.len() as u32).filter(|&t| m.alive(t)) {
+                            assert!(crate::geom::tet_quality::positive_and_not_flat(
+                                &m.corners(m.tets[t as usize])
+                            ));
+                        }
+                    }
+                }
+                // Chords only allow more.
+                assert!(!a || b, "{r} {k}");
+                if b && !a {
+                    both += 1;
+                    let invalid = (0..chorded.tets.len() as u32)
+                        .filter(|&t| chorded.alive(t))
+                        .any(|t| chorded.q[t as usize] <= 0.0);
+                    assert!(invalid);
+                }
+            }
+        }
+        assert!(both > 0, "no merge that only chords allow");
     }
 
     /// A vertex whose search failed is not searched again until its star changes (the
