@@ -155,15 +155,19 @@ pub(super) fn contract_fewer(
         }
         s.new_tets.push(nv);
     }
+    replace_touched(m, s);
+    true
+}
+
+/// Replace the tets `s.touched` by `s.new_tets`, each scored.
+fn replace_touched(m: &mut LinMesh, s: &ContractScratch) {
     for &t in &s.touched {
         m.remove(t);
     }
-    for i in 0..s.new_tets.len() {
-        let v = s.new_tets[i];
+    for &v in &s.new_tets {
         let q = m.quality(v);
         m.add(v, q);
     }
-    true
 }
 
 /// Try contracting the edge (r, k), removing the interior vertex `r`. Returns true when
@@ -224,13 +228,6 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
             s.new_tets.push(tv.map(|x| if x == r { k } else { x }));
         }
     }
-    for &t in &s.touched {
-        m.remove(t);
-    }
-    for i in 0..s.new_tets.len() {
-        let v = s.new_tets[i];
-        let q = m.quality(v);
-        m.add(v, q);
-    }
+    replace_touched(m, s);
     true
 }

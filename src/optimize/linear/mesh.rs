@@ -228,6 +228,18 @@ impl<'a> LinMesh<'a> {
             })
     }
 
+    /// The vertices sharing a tet with `v`, sorted.
+    pub fn neighbours(&self, v: u32) -> Vec<u32> {
+        let mut around: Vec<u32> = self.vt[v as usize]
+            .iter()
+            .flat_map(|&t| self.tets[t as usize])
+            .filter(|&x| x != v)
+            .collect();
+        around.sort_unstable();
+        around.dedup();
+        around
+    }
+
     /// True for a live tet slot.
     #[inline]
     pub fn alive(&self, t: u32) -> bool {

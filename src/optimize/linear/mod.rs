@@ -216,11 +216,8 @@ pub struct LinearSeconds {
 }
 
 /// In the sliver passes: the unforced slivers left, as the sliver census will count
-/// them (a corner dihedral angle below the tet's floor, [`Boundary::tet_sliver_floor`]).
-/// A tet scoring in (0, 1) is one; one scoring ≤ 0 (inverted, flat or not valid as a P2
-/// element) is one only by its corners' angles: the straightening after the high-order
-/// stage makes a P2-invalid tet valid without moving a corner. Counting every tet below 1
-/// chose, on OpenSCAD's GEB, a run leaving 6 (5 slivers) over one leaving 7 (4 slivers).
+/// them ([`LinMesh::unforced`]; not every tet scored below 1, which counts P2-invalid
+/// tets the straightening makes valid, and chose runs that left more slivers).
 fn unforced_left(m: &LinMesh) -> usize {
     (0..m.tets.len())
         .filter(|&t| m.alive(t as u32) && m.unforced(m.tets[t], m.q[t]))
@@ -588,14 +585,7 @@ fn contract_leftovers(m: &mut LinMesh, chords: bool, sc: &mut ContractScratch) {
                 if m.bnd.is_fixed(r) || m.vt[r as usize].is_empty() {
                     continue;
                 }
-                let mut around: Vec<u32> = m.vt[r as usize]
-                    .iter()
-                    .flat_map(|&t| m.tets[t as usize])
-                    .filter(|&x| x != r)
-                    .collect();
-                around.sort_unstable();
-                around.dedup();
-                if around
+                if m.neighbours(r)
                     .into_iter()
                     .any(|k| contract::contract_fewer(m, r, k, chords, sc))
                 {
@@ -1170,16 +1160,7 @@ mod tests {
         assert_eq!(unforced_left(&m), 0);
         let pairs: Vec<(u32, u32)> = (0..m.pts.len() as u32)
             .filter(|&r| !bnd.is_fixed(r))
-            .flat_map(|r| {
-                let mut ks: Vec<u32> = m.vt[r as usize]
-                    .iter()
-                    .flat_map(|&t| m.tets[t as usize])
-                    .filter(|&x| x != r)
-                    .collect();
-                ks.sort_unstable();
-                ks.dedup();
-                ks.into_iter().map(move |k| (r, k))
-            })
+            .flat_map(|r| m.neighbours(r).into_iter().map(move |k| (r, k)))
             .collect();
         for &(r, k) in &pairs {
             assert!(!contract::contract_fewer(&mut m, r, k, false, &mut sc));
@@ -1224,14 +1205,7 @@ mod tests {
         let mut sc = ContractScratch::default();
         let mut both = 0;
         for r in (0..c.pts.len() as u32).filter(|&r| !bnd.is_fixed(r)) {
-            let mut ks: Vec<u32> = m0.vt[r as usize]
-                .iter()
-                .flat_map(|&t| m0.tets[t as usize])
-                .filter(|&x| x != r && bnd.is_fixed(x))
-                .collect();
-            ks.sort_unstable();
-            ks.dedup();
-            for k in ks {
+            for k in m0.neighbours(r).into_iter().filter(|&x| bnd.is_fixed(x)) {
                 let mut pts = c.pts.clone();
                 pts[r as usize] = std::array::from_fn(|d| {
                     0.97 * c.pts[k as usize][d] + 0.03 * c.pts[r as usize][d]
