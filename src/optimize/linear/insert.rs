@@ -157,9 +157,8 @@ pub(super) fn split_edge(
 /// in the rounds that may, [`InsertScratch::trade_stuck`]) or, in those rounds of the
 /// runs whose cavities grow ([`InsertScratch::grow`], the sliver rounds' third and
 /// fourth runs), any ones: there a trade's new slivers, each on the new interior vertex,
-/// are lifted by the rounds after it more often than not. On the OpenSCAD corpus,
-/// unforced slivers left: logo_and_text 6 -> 0, example020 17 -> 14, example005 4 -> 3,
-/// no part more (34 -> 24; any trade in the second run's rounds too gave the same).
+/// are lifted by the rounds after it more often than not (on the OpenSCAD corpus, no
+/// part was left with more; CHANGELOG has the counts).
 fn unforced_count_allowed(
     m: &LinMesh,
     s: &InsertScratch,

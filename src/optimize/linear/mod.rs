@@ -285,14 +285,11 @@ pub fn improve_linear(
 /// again from the same tets with multi-face removal (Shewchuk's) after the 2-3
 /// flips in every pass (in the sliver rounds, only in their fourth run, as the first
 /// time), and the run that leaves fewer is kept, the first on a tie. Each run takes a
-/// path of its own: on the OpenSCAD parts with some left, unforced slivers in the
-/// finished mesh first -> second run: example020 73 -> 37, sign 33 -> 2, example010
-/// 10 -> 0, example012 4 -> 2, example021 1 -> 0, animation 1 -> 0, but GEB 12 -> 16 and
-/// example005 15 -> 16 (where the first, with fewer at this stage too, is kept). One
-/// after the other, the second run costs that part's stage time again (sign 8 -> 14 s
-/// in all); side by side ([`LinearParams::side_by_side`], the whole fill's), on two
-/// threads, sign takes 10 s, GEB 11.8 s as with one run, example020 40 s (43 s with one
-/// run: the second is faster), with the same meshes; at the peak, a third more memory.
+/// path of its own, and neither is the better one on every part (CHANGELOG has the
+/// counts). Side by side ([`LinearParams::side_by_side`], the whole fill's), on two
+/// threads, the second run costs little wall time where the first leaves some, and
+/// stops where it leaves none; the meshes are those of one run after the other, at the
+/// cost of a third more memory at the peak.
 pub fn improve_linear_known(
     pts: Vec<P3>,
     tets: Vec<[u32; 4]>,
@@ -462,26 +459,24 @@ fn linear_run(
 /// unforced slivers is kept, the earlier run's on a tie. A split of a sliver's interior
 /// edge starts its new vertex on the sliver's nearly flat plane, where the smoother's
 /// ascent often cannot leave; the search finds a position off it. Run alone, the
-/// searching rounds take another path, which ends with more on some parts (GEB 15 -> 17
-/// at this stage), and neither searching run is the better one everywhere (OpenSCAD's
-/// sign: 68 plain, 33 from the start, 51 from the end; example020: 433, 393, 377 in the
-/// finished mesh); with all three, no part ends with more than the plain rounds leave.
-/// The third run's cavity insertions may also grow their cavities
-/// ([`InsertScratch::grow`](insert::InsertScratch)): on a cluster of flat tets whose
-/// corners are all on the boundary, the cavity of a tet and two rings of its neighbours
-/// is often seen whole from none of its centroids (OpenSCAD's example020: 377 unforced
-/// slivers without, 137 with; allowed in the other runs too, it leaves more on some
-/// parts). Where some are still left, a fourth run, again from the start, without the
-/// searches, adds multi-face removal ([`remove_faces`]) to the grown cavities: it takes
-/// a path of its own, which ends with fewer on some parts (OpenSCAD's example020: 137 ->
-/// 73 in the finished mesh, example021: 12 -> 1) and more on others (sign: 54 at this
-/// stage against the other runs' 40; tried in every run instead, sign ended with 50,
-/// example010 with 24), so it too is kept only where it leaves the fewest.
+/// searching rounds take another path, which ends with more on some parts, and neither
+/// searching run is the better one everywhere; with all three, no part ends with more
+/// than the plain rounds leave. The third run's cavity insertions may also grow their
+/// cavities ([`InsertScratch::grow`](insert::InsertScratch)): on a cluster of flat tets
+/// whose corners are all on the boundary, the cavity of a tet and two rings of its
+/// neighbours is often seen whole from none of its centroids (allowed in the other runs
+/// too, growing leaves more on some parts). Where some are still left, a fourth run,
+/// again from the start, without the searches, adds multi-face removal
+/// ([`remove_faces`]) to the grown cavities: it takes a path of its own, which ends with
+/// fewer on some parts and more on others (also when tried in every run), so it too is
+/// kept only where it leaves the fewest. Last, where some are left in the mesh kept,
+/// [`contract_leftovers`] merges their interior corners into a neighbour wherever that
+/// leaves fewer. (CHANGELOG has the counts behind each of these choices.)
 ///
 /// The runs go two at a time on the pool's threads ([`speculate`]): the plain one beside
 /// the searching one from the start, the one from where the plain run ended beside the
-/// fourth. The mesh is the one they make one after the other (OpenSCAD's example020:
-/// the rounds' 16.7 s -> 12.2 s on two threads; 110 -> 178 MB at the peak).
+/// fourth. The mesh is the one they make one after the other, in less wall time and
+/// more memory at the peak.
 fn unforced_sliver_passes(
     m: &mut LinMesh,
     prm: &LinearParams,
