@@ -132,25 +132,26 @@ fn tetgen_quality(base: &Path) -> Option<(usize, f64, curvetet::SliverCensus)> {
         let i = (x as u32).checked_sub(first)?;
         ((i as usize) < n).then_some(i)
     };
+    // The first `N` node ids of a row after its own number.
+    fn ids<const N: usize>(r: &[f64], index: impl Fn(f64) -> Option<u32>) -> Option<[u32; N]> {
+        let c = r.get(1..1 + N)?;
+        let mut out = [0; N];
+        for (o, &x) in out.iter_mut().zip(c) {
+            *o = index(x)?;
+        }
+        Some(out)
+    }
     let mut mesh = curvetet::TetMesh {
         nodes: pts,
         ..Default::default()
     };
     for r in rows(&read("1.ele")?) {
-        let c: Vec<u32> = r
-            .get(1..5)?
-            .iter()
-            .map(|&x| index(x))
-            .collect::<Option<_>>()?;
-        mesh.tets.push([c[0], c[1], c[2], c[3], 0, 0, 0, 0, 0, 0]);
+        let [a, b, c, d] = ids::<4>(&r, index)?;
+        mesh.tets.push([a, b, c, d, 0, 0, 0, 0, 0, 0]);
     }
     for r in rows(&read("1.face")?) {
-        let c: Vec<u32> = r
-            .get(1..4)?
-            .iter()
-            .map(|&x| index(x))
-            .collect::<Option<_>>()?;
-        mesh.boundary.push([c[0], c[1], c[2], 0, 0, 0]);
+        let [a, b, c] = ids::<3>(&r, index)?;
+        mesh.boundary.push([a, b, c, 0, 0, 0]);
     }
     let min_dihedral = mesh
         .tets

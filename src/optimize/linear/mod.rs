@@ -219,9 +219,12 @@ pub struct LinearSeconds {
 /// them ([`LinMesh::unforced`]; not every tet scored below 1, which counts P2-invalid
 /// tets the straightening makes valid, and chose runs that left more slivers).
 fn unforced_left(m: &LinMesh) -> usize {
-    (0..m.tets.len())
-        .filter(|&t| m.alive(t as u32) && m.unforced(m.tets[t], m.q[t]))
-        .count()
+    unforced_tets(m).count()
+}
+
+/// The slots of the live tets [`LinMesh::unforced`] counts.
+fn unforced_tets<'m>(m: &'m LinMesh) -> impl Iterator<Item = usize> + 'm {
+    (0..m.tets.len()).filter(|&t| m.alive(t as u32) && m.unforced(m.tets[t], m.q[t]))
 }
 
 /// Worst quality and the count of tets below `goal`.
@@ -570,10 +573,7 @@ const LEFTOVER_ROUNDS: usize = 4;
 /// lowers it is made: the stage never ends with more.
 fn contract_leftovers(m: &mut LinMesh, chords: bool, sc: &mut ContractScratch) {
     for _ in 0..LEFTOVER_ROUNDS {
-        let slivers: Vec<[u32; 4]> = (0..m.tets.len())
-            .filter(|&t| m.alive(t as u32) && m.unforced(m.tets[t], m.q[t]))
-            .map(|t| m.tets[t])
-            .collect();
+        let slivers: Vec<[u32; 4]> = unforced_tets(m).map(|t| m.tets[t]).collect();
         let mut merged = false;
         for tv in slivers {
             for r in tv {
@@ -1229,10 +1229,15 @@ mod tests {
                 assert!(!a || b, "{r} {k}");
                 if b && !a {
                     both += 1;
-                    let invalid = (0..chorded.tets.len() as u32)
-                        .filter(|&t| chorded.alive(t))
-                        .any(|t| chorded.q[t as usize] <= 0.0);
-                    assert!(invalid);
+                    // What made the difference: a tet the merge made (on `k`, not in the
+                    // mesh before it) that is not valid as a P2 element.
+                    let old: std::collections::HashSet<[u32; 4]> =
+                        plain.tets.iter().copied().collect();
+                    let made_invalid = chorded.vt[k as usize]
+                        .iter()
+                        .filter(|&&t| !old.contains(&chorded.tets[t as usize]))
+                        .any(|&t| chorded.q[t as usize] <= 0.0);
+                    assert!(made_invalid, "{r} {k}");
                 }
             }
         }
