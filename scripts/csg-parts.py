@@ -6,7 +6,9 @@
 #     manifold3d)
 # PART: bracket (a 120 x 60 x 3 plate with three holes and two bosses through it),
 # finball (a sphere with a box cut out and a thin fin through it), cross (two
-# cylinders crossing at 70 degrees).
+# cylinders crossing at 70 degrees), drilled (a sphere with six holes of mixed sizes
+# drilled through it at random directions: the booleans leave triangles with an edge of
+# 4e-6 beside edges of 14, aspect ratios up to 1.9 million).
 import sys
 
 import numpy as np
@@ -31,8 +33,18 @@ elif part == 'cross':
     m = cylinder(radius=8, height=60, sections=64).union(
         cylinder(radius=7, height=60, sections=56,
                  transform=rotation_matrix(np.radians(70), [1, 0, 0])))
+elif part == 'drilled':
+    m = icosphere(subdivisions=4, radius=15)
+    rng = np.random.default_rng(5)
+    z = np.array([0, 0, 1.0])
+    for _ in range(6):
+        d = rng.normal(size=3)
+        d /= np.linalg.norm(d)
+        turn = rotation_matrix(np.arccos(np.clip(d @ z, -1, 1)), np.cross(z, d))
+        m = m.difference(cylinder(radius=rng.uniform(0.8, 3), height=40,
+                                  sections=int(rng.integers(12, 40)), transform=turn))
 else:
-    sys.exit(f'unknown part {part}: bracket, finball or cross')
+    sys.exit(f'unknown part {part}: bracket, finball, cross or drilled')
 assert m.is_watertight
 m.export(out)
 print(f'{out}: {len(m.faces)} triangles, volume {m.volume:.6f}')
