@@ -21,6 +21,8 @@ pub(super) struct ContractScratch {
     ring_v: Vec<u32>,
     touched: Vec<u32>,
     new_tets: Vec<[u32; 4]>,
+    /// The quality of each of `new_tets`.
+    new_q: Vec<f64>,
 }
 
 fn sorted3(mut f: [u32; 3]) -> [u32; 3] {
@@ -140,6 +142,7 @@ pub(super) fn contract_fewer(
     s.touched.clear();
     s.touched.extend_from_slice(star);
     s.new_tets.clear();
+    s.new_q.clear();
     let mut after = 0;
     for &t in &s.touched {
         let tv = m.tets[t as usize];
@@ -154,18 +157,18 @@ pub(super) fn contract_fewer(
             return false;
         }
         s.new_tets.push(nv);
+        s.new_q.push(q);
     }
     replace_touched(m, s);
     true
 }
 
-/// Replace the tets `s.touched` by `s.new_tets`, each scored.
+/// Replace the tets `s.touched` by `s.new_tets`, scored `s.new_q`.
 fn replace_touched(m: &mut LinMesh, s: &ContractScratch) {
     for &t in &s.touched {
         m.remove(t);
     }
-    for &v in &s.new_tets {
-        let q = m.quality(v);
+    for (&v, &q) in s.new_tets.iter().zip(&s.new_q) {
         m.add(v, q);
     }
 }
@@ -222,10 +225,13 @@ pub(super) fn contract(m: &mut LinMesh, r: u32, k: u32, eps: f64, s: &mut Contra
     };
     m.pts[k as usize] = p;
     s.new_tets.clear();
+    s.new_q.clear();
     for &t in &s.touched {
         let tv = m.tets[t as usize];
         if !(tv.contains(&r) && tv.contains(&k)) {
-            s.new_tets.push(tv.map(|x| if x == r { k } else { x }));
+            let nv = tv.map(|x| if x == r { k } else { x });
+            s.new_tets.push(nv);
+            s.new_q.push(m.quality(nv));
         }
     }
     replace_touched(m, s);

@@ -1198,7 +1198,7 @@ mod tests {
         let bnd = c.boundary();
         let m0 = LinMesh::new(c.pts.clone(), c.tets.clone(), &bnd, ElementQuality);
         let mut sc = ContractScratch::default();
-        let mut both = 0;
+        let mut only_chords = 0;
         for r in (0..c.pts.len() as u32).filter(|&r| !bnd.is_fixed(r)) {
             for k in m0.neighbours(r).into_iter().filter(|&x| bnd.is_fixed(x)) {
                 let mut pts = c.pts.clone();
@@ -1228,7 +1228,7 @@ mod tests {
                 // Chords only allow more.
                 assert!(!a || b, "{r} {k}");
                 if b && !a {
-                    both += 1;
+                    only_chords += 1;
                     // What made the difference: a tet the merge made (on `k`, not in the
                     // mesh before it) that is not valid as a P2 element.
                     let old: std::collections::HashSet<[u32; 4]> =
@@ -1241,7 +1241,7 @@ mod tests {
                 }
             }
         }
-        assert!(both > 0, "no merge that only chords allow");
+        assert!(only_chords > 0, "no merge that only chords allow");
     }
 
     /// A vertex whose search failed is not searched again until its star changes (the
