@@ -129,6 +129,11 @@ fn whole_fill_trying(
                 patience,
                 &mut stages,
             );
+            // Where recovery stopped, for the user to look at.
+            let r = r.map_err(|e| match stages.stuck_near {
+                Some(p) => format!("{e}, near ({:.6}, {:.6}, {:.6})", p[0], p[1], p[2]),
+                None => e.to_string(),
+            });
             tries.push(FillTry {
                 steiner_at: match split {
                     Split::AtCrossing => "crossings",
@@ -136,7 +141,7 @@ fn whole_fill_trying(
                     Split::NoFlatTets => "no flat tets",
                 },
                 points_outside: with_outside,
-                error: r.as_ref().err().map(|e| e.to_string()),
+                error: r.as_ref().err().cloned(),
                 delaunay_seconds: stages.delaunay,
                 edges_seconds: stages.edges,
                 faces_seconds: stages.faces,

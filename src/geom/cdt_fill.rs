@@ -72,6 +72,9 @@ pub(crate) struct Stages {
     /// Steiner points that only the last round's larger cavities could move off the
     /// surface ([`GROW_LIMIT_LAST`]), or that stayed on it.
     pub wide_cavity_points: usize,
+    /// Where edge or face recovery could not go on (for the error): the point a
+    /// segment's recovery had reached, or the centroid of the triangle not recovered.
+    pub stuck_near: Option<P3>,
 }
 
 /// Tetrahedralize the region bounded by `faces` (indices into `pts`, each oriented with the
@@ -126,11 +129,18 @@ pub(crate) fn fill_from(
     }
     let r = c.recover_edges();
     stages.edges = lap();
+    stages.stuck_near = c.stuck_near;
     stages.steiner_points = c.dt.pts.len() - n - 4;
     r?;
-    let r = (0..faces.len()).try_for_each(|i| c.recover_face(i));
+    let r = (0..faces.len()).try_for_each(|i| {
+        c.recover_face(i).inspect_err(|_| {
+            let p = faces[i].map(|v| c.dt.p(v));
+            c.stuck_near = Some(std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0));
+        })
+    });
     stages.faces = lap();
     stages.steiner_points = c.dt.pts.len() - n - 4;
+    stages.stuck_near = c.stuck_near;
     r?;
     c.dt.refuse_flat = false;
     c.keep_enclosed()?;
@@ -292,6 +302,8 @@ struct Cdt<'a> {
     defer_tiny: bool,
     /// Points deferred so in the current round ([`Cdt::move_round`]).
     deferred: usize,
+    /// Where recovery stopped ([`Stages::stuck_near`]).
+    stuck_near: Option<P3>,
 }
 
 impl<'a> Cdt<'a> {
@@ -333,6 +345,7 @@ impl<'a> Cdt<'a> {
             wide_cavity_points: 0,
             defer_tiny: true,
             deferred: 0,
+            stuck_near: None,
         })
     }
 
@@ -420,9 +433,9 @@ impl<'a> Cdt<'a> {
             let Some((t, k)) = self.dt.leaving(cur, goal) else {
                 // Rounded Steiner points can leave no tet that the straight piece
                 // leaves cur through: a point between them on the segment instead.
-                let s = self
-                    .insert_between(a, b, cur, goal)
-                    .ok_or("no tet leaves a segment's end toward its other end")?;
+                let s = self.insert_between(a, b, cur, goal).ok_or_else(|| {
+                    self.stuck_at(cur, "no tet leaves a segment's end toward its other end")
+                })?;
                 goals.push(s);
                 continue;
             };
@@ -439,7 +452,7 @@ impl<'a> Cdt<'a> {
             let p = match zeros {
                 0 => segment_plane(pc, pb, fp),
                 1 => segment_line(pc, pb, fp[on_edge], fp[(on_edge + 1) % 3]),
-                _ => return Err("a surface edge passes through a vertex"),
+                _ => return Err(self.stuck_at(cur, "a surface edge passes through a vertex")),
             };
             let split = match zeros {
                 0 => {
@@ -481,8 +494,12 @@ impl<'a> Cdt<'a> {
                             self.dt.on_line.remove(&next);
                             // ...else a point between cur and goal, away from the face
                             // whose crossing is too near other points.
-                            self.insert_between(a, b, cur, goal)
-                                .ok_or("a Steiner point on a surface edge would invert a tet")?
+                            self.insert_between(a, b, cur, goal).ok_or_else(|| {
+                                self.stuck_at(
+                                    cur,
+                                    "a Steiner point on a surface edge would invert a tet",
+                                )
+                            })?
                         }
                     }
                 }
@@ -495,7 +512,13 @@ impl<'a> Cdt<'a> {
                 goals.push(s);
             }
         }
-        Err("edge recovery did not end")
+        Err(self.stuck_at(cur, "edge recovery did not end"))
+    }
+
+    /// Note that recovery stopped at vertex `v` ([`Stages::stuck_near`]); `why` back.
+    fn stuck_at(&mut self, v: u32, why: &'static str) -> &'static str {
+        self.stuck_near = Some(self.dt.p(v));
+        why
     }
 
     /// Whether segment `cur`-`goal` leaves `cur` exactly through an edge of the face it
@@ -2111,5 +2134,33 @@ mod tests {
         assert!(before > 100 && after <= 2, "{before} -> {after} flat tets");
         let r = fill_and_check_with(&pts, &outward, Split::NoFlatTets).unwrap();
         assert!(r.tets.len() >= outward.len() / 4);
+    }
+
+    /// A fill that stops says where: on the aniso torus of 12 segments, at crossings, the
+    /// point its edge recovery had reached, on that surface edge within rounding.
+    #[test]
+    fn a_failed_fill_says_where_recovery_stopped() {
+        let (pts, outward) = surface_corners("tori/aniso_12x44.off");
+        let mut stages = Stages::default();
+        let faces = inward(&outward);
+        let r = fill(
+            &pts,
+            &faces,
+            Split::AtCrossing,
+            None,
+            Patience::Exhaustive,
+            &mut stages,
+        );
+        assert!(r.is_err());
+        let p = stages.stuck_near.expect("no place named");
+        let on_an_edge = outward.iter().any(|f| {
+            (0..3).any(|k| {
+                let (a, b) = (pts[f[k] as usize], pts[f[(k + 1) % 3] as usize]);
+                line_dist(p, a, b) < 1e-12 * dist(a, b)
+                    && dot(sub(p, a), sub(b, a)) >= 0.0
+                    && dot(sub(p, b), sub(a, b)) >= 0.0
+            })
+        });
+        assert!(on_an_edge, "{p:?} is on no surface edge");
     }
 }
