@@ -98,9 +98,10 @@ pub struct FrontStats {
 #[derive(Debug, Default, Clone, serde::Serialize)]
 pub struct FillTry {
     /// Where edge recovery put its Steiner points: `"crossings"` (where a segment
-    /// leaves a tet), `"halves"` (halving the segment), or `"no flat tets"` (flips in
+    /// leaves a tet), `"halves"` (halving the segment), `"no flat tets"` (flips in
     /// the plane of coplanar surface points first, then at crossings, with no
-    /// numerically flat tet in the recovery).
+    /// numerically flat tet in the recovery), or `"recursive flips, then halves"` (the
+    /// last try).
     pub steiner_at: &'static str,
     /// Whether the interior points outside the surface were inserted too (they change
     /// the Delaunay tetrahedralization recovery starts from; their tets are dropped).

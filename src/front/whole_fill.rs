@@ -15,7 +15,8 @@
 //!
 //! The fill places Steiner points at segment crossings; where that fails, or its first
 //! round of moving them off the surface leaves many on it ([`Patience`]), it is run again
-//! halving the segments ([`Split`]).
+//! halving the segments ([`Split`]); where every such try fails, a last one recovers the
+//! missing segments by recursive flips first ([`Split::FlipsThenHalving`]).
 
 use super::grid::{Aabb, FaceGrid};
 use super::size::SizeField;
@@ -82,7 +83,14 @@ fn whole_fill_trying(
     let mut why = Vec::new();
     let mut filled = None;
     let mut tries = Vec::new();
-    'fills: for with_outside in [false, true] {
+    // Last, with the points inside: recursive flips before halving (slow: only where
+    // every other way fails).
+    let ways: [(bool, &[Split]); 3] = [
+        (false, inside),
+        (true, &[Split::AtCrossing, Split::Halving]),
+        (false, &[Split::FlipsThenHalving]),
+    ];
+    'fills: for (with_outside, splits) in ways {
         if with_outside {
             // The candidates again, those outside kept too (the first try's have only
             // those inside: clearing the others, most of the octree's, took most of
@@ -104,11 +112,6 @@ fn whole_fill_trying(
         let clock = std::time::Instant::now();
         let dt = cdt_fill::delaunay(&all);
         let mut built = clock.elapsed().as_secs_f64();
-        let splits: &[Split] = if with_outside {
-            &[Split::AtCrossing, Split::Halving]
-        } else {
-            inside
-        };
         for &split in splits {
             // Halving follows a try at crossings, so that one may give up early.
             // The last try has no other way after it.
@@ -116,6 +119,7 @@ fn whole_fill_trying(
                 Split::AtCrossing | Split::NoFlatTets => Patience::GiveUpEarly,
                 Split::Halving if with_outside => Patience::LastResort,
                 Split::Halving => Patience::Exhaustive,
+                Split::FlipsThenHalving => Patience::LastResort,
             };
             let mut stages = cdt_fill::Stages {
                 delaunay: std::mem::take(&mut built),
@@ -139,6 +143,7 @@ fn whole_fill_trying(
                     Split::AtCrossing => "crossings",
                     Split::Halving => "halves",
                     Split::NoFlatTets => "no flat tets",
+                    Split::FlipsThenHalving => "recursive flips, then halves",
                 },
                 points_outside: with_outside,
                 error: r.as_ref().err().cloned(),
@@ -497,6 +502,28 @@ mod tests {
         check_whole_fill("tests/data/openscad/offset.stl");
         // Crossings next to nearly flat tets.
         check_whole_fill("tests/data/openscad/example007.stl");
+    }
+
+    /// A sphere drilled by two rotated holes through its centre
+    /// (`scripts/csg-parts.py drilled2`): every try at crossings or halving stops
+    /// (Steiner points rounded among nearly coplanar chains of other segments' points);
+    /// the last try, recursive flips before halving, fills it, boundary kept.
+    #[test]
+    fn a_drilled_sphere_fills_by_recursive_flips_first() {
+        let gz =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/csg/drilled2.stl.gz");
+        let mut stl = tempfile::Builder::new().suffix(".stl").tempfile().unwrap();
+        let file = std::fs::File::open(&gz).unwrap();
+        std::io::copy(&mut flate2::read::GzDecoder::new(file), &mut stl).unwrap();
+        let out = check_whole_fill(stl.path().to_str().unwrap());
+        let tries = &out.stats.whole_fill_tries;
+        assert!(
+            tries[..tries.len() - 1].iter().all(|t| t.error.is_some()),
+            "{tries:?}"
+        );
+        let last = tries.last().unwrap();
+        assert_eq!(last.steiner_at, "recursive flips, then halves");
+        assert!(last.error.is_none(), "{last:?}");
     }
 
     /// OpenSCAD part `name`'s whole fill with one way (`split`, `patience`), its interior

@@ -149,7 +149,7 @@ pub(crate) fn fill_from(
     stages.wide_cavity_points = c.wide_cavity_points;
     r?;
     c.contract_flat();
-    if split == Split::Halving {
+    if matches!(split, Split::Halving | Split::FlipsThenHalving) {
         c.contract_slivers();
     }
     if let Some(h) = height {
@@ -174,12 +174,30 @@ const SLIVER_CONTRACT_DEG: f64 = 5.0;
 /// Rounds of [`Cdt::contract_flat`].
 const CONTRACT_ROUNDS: usize = 8;
 
+/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass (on drilled2, levels
+/// 0-4 leave 244 of 624 segments missing; levels 5-12 bring in 26 more at twice the
+/// time).
+const DEEP_FLIP_LEVELS: u32 = 4;
+
+/// [`Delaunay::flipnm`] calls per segment and level in that pass.
+const DEEP_FLIP_BUDGET: usize = 20_000;
+
 /// Rounds of [`Cdt::lift_flat_tets`].
 const LIFT_ROUNDS: usize = 2;
 
 /// Where edge recovery puts a Steiner point when flips cannot bring a segment piece in.
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 pub(crate) enum Split {
+    /// [`Split::Halving`], after a pass of recursive flips ([`Delaunay::recover_edge_nm`])
+    /// over every segment missing from the Delaunay tetrahedralization, the link level
+    /// raised from 0 to [`DEEP_FLIP_LEVELS`], the tetrahedralization restored where a
+    /// segment's flips fail. TetGen recovers CAD booleans' segments this way (on a
+    /// sphere drilled by two rotated holes, `scripts/csg-parts.py drilled2`, all 625
+    /// missing ones, with 13 Steiner points inside), where the greedy flips of the
+    /// other ways recover 81 and leave over a thousand Steiner points on the surface
+    /// among nearly coplanar chains; this pass brings 380 in, and halving then fills.
+    /// Slow (about 100 s there), so the whole fill's last try only.
+    FlipsThenHalving,
     /// Where the piece leaves the tet at its current end: one point per crossed face at
     /// most, but a rounded point on a face (the other ways follow where that inverts a
     /// tet).
@@ -388,6 +406,9 @@ impl<'a> Cdt<'a> {
                 self.chains.insert(*e, e.to_vec());
             }
         }
+        if self.split == Split::FlipsThenHalving {
+            self.deep_flips(&edges);
+        }
         for e in &edges {
             if !self.chains.contains_key(e) {
                 let chain = self.recover_segment(e[0], e[1])?;
@@ -395,6 +416,35 @@ impl<'a> Cdt<'a> {
             }
         }
         Ok(())
+    }
+
+    /// [`Split::FlipsThenHalving`]'s pass: each missing segment of `edges` by recursive
+    /// flips, level by level; one that comes in is fixed, one that does not leaves the
+    /// tetrahedralization as it was before its try.
+    fn deep_flips(&mut self, edges: &[[u32; 2]]) {
+        let mut missing: Vec<[u32; 2]> = edges
+            .iter()
+            .copied()
+            .filter(|e| !self.chains.contains_key(e))
+            .collect();
+        for level in 0..=DEEP_FLIP_LEVELS {
+            let mut left = Vec::new();
+            for e in missing {
+                let before = self.dt.clone();
+                let mut budget = DEEP_FLIP_BUDGET;
+                if self.dt.recover_edge_nm(e[0], e[1], level, &mut budget) {
+                    self.dt.fixed_edges.insert(e);
+                    self.chains.insert(e, e.to_vec());
+                } else {
+                    self.dt = before;
+                    left.push(e);
+                }
+            }
+            missing = left;
+            if missing.is_empty() {
+                break;
+            }
+        }
     }
 
     /// Make segment ab a chain of mesh edges: flips, else a Steiner point where the
@@ -424,7 +474,9 @@ impl<'a> Cdt<'a> {
             // crosses a mesh edge exactly: split that edge at the crossing instead.
             let short = dist(self.dt.p(cur), self.dt.p(goal))
                 < dist(self.dt.p(a), self.dt.p(b)) * 0.5f64.powi(HALVING_DEPTH);
-            if self.split == Split::Halving && !(short && self.crosses_an_edge(cur, goal)) {
+            if matches!(self.split, Split::Halving | Split::FlipsThenHalving)
+                && !(short && self.crosses_an_edge(cur, goal))
+            {
                 if let Some(s) = self.insert_between(a, b, cur, goal) {
                     goals.push(s);
                     continue;

@@ -600,6 +600,188 @@ impl Delaunay {
     /// Edge removal (n-to-2n-4 flip): replace the `around` tets sharing edge (x, y) by
     /// tets on a fan triangulation of their ring of other vertices, joined to x and to y,
     /// trying a fan from each ring vertex. False (nothing changed) if none is valid.
+    /// The tet of edge (x, y)'s star holding ring vertex r, and its local index of the
+    /// vertex opposite face (x, y, r).
+    fn star_face(&self, around: &[u32], x: u32, y: u32, r: u32) -> Option<(u32, usize)> {
+        around.iter().find_map(|&t| {
+            let tv = self.tets[t as usize];
+            if !self.alive[t as usize] || !tv.contains(&r) {
+                return None;
+            }
+            (0..4)
+                .find(|&k| ![x, y, r].contains(&tv[k]))
+                .map(|k| (t, k))
+        })
+    }
+
+    /// The edges of face k of tet t (other than `skip`) whose tet in the face's 2-3 flip
+    /// would not be valid ([`Delaunay::valid_new`]): the reflex edges that block the flip.
+    fn blocking_edges(&self, t: u32, k: usize, skip: [u32; 2]) -> Vec<[u32; 2]> {
+        let tv = self.tets[t as usize];
+        let u = self.adj[t as usize][k];
+        if u == NONE {
+            return Vec::new();
+        }
+        let f = FACES[k].map(|j| tv[j]);
+        let Some(&b) = self.tets[u as usize].iter().find(|v| !f.contains(v)) else {
+            return Vec::new();
+        };
+        (0..3)
+            .map(|i| [f[i], f[(i + 1) % 3]])
+            .filter(|e| sorted2(e[0], e[1]) != sorted2(skip[0], skip[1]))
+            .filter(|e| !self.valid_new([e[0], e[1], tv[k], b]))
+            .collect()
+    }
+
+    /// Remove edge (x, y) by a sequence of flips (after Si's flipnm): 3-2 when three tets
+    /// share it; else shrink its star by 2-3 flips of its faces; where those are blocked
+    /// by reflex link edges, remove those first, `level` levels deep. `anc` holds the
+    /// stars of the edges being removed above this one: no flip here touches their tets
+    /// but the two this edge's star shares with its parent's. True when the edge is gone.
+    pub(crate) fn flipnm(
+        &mut self,
+        x: u32,
+        y: u32,
+        level: u32,
+        budget: &mut usize,
+        anc: &mut Vec<u32>,
+    ) -> bool {
+        if self.fixed_edges.contains(&sorted2(x, y)) {
+            return false;
+        }
+        let base = anc.len();
+        let r = 'star: loop {
+            anc.truncate(base);
+            if *budget == 0 {
+                break false;
+            }
+            *budget -= 1;
+            let around = self.around_edge(x, y);
+            if around.is_empty() {
+                break true;
+            }
+            if around.iter().filter(|t| anc[..base].contains(t)).count() > 2 {
+                break false;
+            }
+            if self.flip32(x, y, &around) || self.remove_edge(x, y, &around) {
+                break true;
+            }
+            let Some(ring) = self.edge_ring(x, y, &around) else {
+                break false;
+            };
+            if ring.len() > 3 {
+                for &r in &ring {
+                    if let Some((t, k)) = self.star_face(&around, x, y, r) {
+                        let u = self.adj[t as usize][k];
+                        if anc[..base].contains(&t) || anc[..base].contains(&u) {
+                            continue;
+                        }
+                        if self.flip23(t, k) {
+                            continue 'star;
+                        }
+                    }
+                }
+            }
+            if level == 0 {
+                break false;
+            }
+            anc.extend_from_slice(&around);
+            for &r in &ring {
+                let Some((t, k)) = self.star_face(&around, x, y, r) else {
+                    continue;
+                };
+                if let Some(e) = self.blocking_edges(t, k, [x, y]).first() {
+                    if self.flipnm(e[0], e[1], level - 1, budget, anc) {
+                        continue 'star;
+                    }
+                }
+            }
+            break false;
+        };
+        anc.truncate(base);
+        r
+    }
+
+    /// Recover edge (a, b) by flips at link level `level` (see [`Delaunay::flipnm`]): the
+    /// face it crosses first from a is 2-3 flipped, or the reflex edge that blocks that
+    /// flip removed; stuck there, the same from b; stuck at both ends, any face it
+    /// crosses further in. `budget` bounds the [`Delaunay::flipnm`] calls. True when the
+    /// edge is there (the flips made on the way are kept either way).
+    pub(crate) fn recover_edge_nm(
+        &mut self,
+        a0: u32,
+        b0: u32,
+        level: u32,
+        budget: &mut usize,
+    ) -> bool {
+        let mut stuck_from = [false; 2];
+        let (mut a, mut b) = (a0, b0);
+        loop {
+            if stuck_from[0] && stuck_from[1] {
+                // Both ends stuck: any face the segment crosses further in.
+                let crossed = self.crossed_faces(a0, b0);
+                let mut moved = false;
+                for (t, k) in crossed {
+                    if !self.alive[t as usize] {
+                        continue;
+                    }
+                    if self.flip23(t, k) {
+                        moved = true;
+                        break;
+                    }
+                    let tv = self.tets[t as usize];
+                    let f = FACES[k].map(|j| tv[j]);
+                    let mut blocked = self.blocking_edges(t, k, [a0, b0]);
+                    if blocked.is_empty() {
+                        blocked = (0..3).map(|i| [f[i], f[(i + 1) % 3]]).collect();
+                    }
+                    if blocked
+                        .into_iter()
+                        .any(|e| self.flipnm(e[0], e[1], level, budget, &mut Vec::new()))
+                    {
+                        moved = true;
+                        break;
+                    }
+                }
+                if !moved || *budget == 0 {
+                    return false;
+                }
+                stuck_from = [false; 2];
+                continue;
+            }
+            if self.has_edge(a, b) {
+                return true;
+            }
+            if *budget == 0 {
+                return false;
+            }
+            let Some((t, k)) = self.leaving(a, b) else {
+                stuck_from[(a != a0) as usize] = true;
+                std::mem::swap(&mut a, &mut b);
+                continue;
+            };
+            if self.flip23(t, k) {
+                stuck_from = [false; 2];
+                continue;
+            }
+            let tv = self.tets[t as usize];
+            let mut blocked = self.blocking_edges(t, k, [a, b]);
+            if blocked.is_empty() {
+                let f = FACES[k].map(|j| tv[j]);
+                blocked = (0..3).map(|i| [f[i], f[(i + 1) % 3]]).collect();
+            }
+            if !blocked
+                .into_iter()
+                .any(|e| self.flipnm(e[0], e[1], level, budget, &mut Vec::new()))
+            {
+                stuck_from[(a != a0) as usize] = true;
+                std::mem::swap(&mut a, &mut b);
+                continue;
+            }
+            stuck_from = [false; 2];
+        }
+    }
+
     pub(crate) fn remove_edge(&mut self, x: u32, y: u32, around: &[u32]) -> bool {
         let n = around.len();
         if !(3..=10).contains(&n) || self.fixed_edges.contains(&sorted2(x, y)) {
