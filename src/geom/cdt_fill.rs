@@ -39,7 +39,7 @@
 use super::delaunay::{closes_up, sorted2, sorted3, Delaunay, FACES, NONE};
 use super::predicates::{orient3d, projection_of};
 use super::tet_quality::{dihedral_extremes, numerically_flat};
-use super::vec3::{axpy, dist, dot, norm, sub, tet_det, tri_normal, P3};
+use super::vec3::{axpy, centroid3, dist, dot, norm, sub, tet_det, tri_normal, P3};
 use rustc_hash::{FxHashMap as HashMap, FxHashSet as HashSet};
 use std::collections::BTreeMap;
 
@@ -135,7 +135,7 @@ pub(crate) fn fill_from(
     let r = (0..faces.len()).try_for_each(|i| {
         c.recover_face(i).inspect_err(|_| {
             let p = faces[i].map(|v| c.dt.p(v));
-            c.stuck_near = Some(std::array::from_fn(|k| (p[0][k] + p[1][k] + p[2][k]) / 3.0));
+            c.stuck_near = Some(centroid3(p[0], p[1], p[2]));
         })
     });
     stages.faces = lap();

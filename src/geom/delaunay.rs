@@ -597,9 +597,6 @@ impl Delaunay {
         (links[j].contains(&ring[0]) && links[j].contains(&ring[n - 1])).then_some(ring)
     }
 
-    /// Edge removal (n-to-2n-4 flip): replace the `around` tets sharing edge (x, y) by
-    /// tets on a fan triangulation of their ring of other vertices, joined to x and to y,
-    /// trying a fan from each ring vertex. False (nothing changed) if none is valid.
     /// The tet of edge (x, y)'s star holding ring vertex r, and its local index of the
     /// vertex opposite face (x, y, r).
     fn star_face(&self, around: &[u32], x: u32, y: u32, r: u32) -> Option<(u32, usize)> {
@@ -722,23 +719,7 @@ impl Delaunay {
                 let crossed = self.crossed_faces(a0, b0);
                 let mut moved = false;
                 for (t, k) in crossed {
-                    if !self.alive[t as usize] {
-                        continue;
-                    }
-                    if self.flip23(t, k) {
-                        moved = true;
-                        break;
-                    }
-                    let tv = self.tets[t as usize];
-                    let f = FACES[k].map(|j| tv[j]);
-                    let mut blocked = self.blocking_edges(t, k, [a0, b0]);
-                    if blocked.is_empty() {
-                        blocked = (0..3).map(|i| [f[i], f[(i + 1) % 3]]).collect();
-                    }
-                    if blocked
-                        .into_iter()
-                        .any(|e| self.flipnm(e[0], e[1], level, budget, &mut Vec::new()))
-                    {
+                    if self.alive[t as usize] && self.clear_face(t, k, [a0, b0], level, budget) {
                         moved = true;
                         break;
                     }
@@ -760,20 +741,7 @@ impl Delaunay {
                 std::mem::swap(&mut a, &mut b);
                 continue;
             };
-            if self.flip23(t, k) {
-                stuck_from = [false; 2];
-                continue;
-            }
-            let tv = self.tets[t as usize];
-            let mut blocked = self.blocking_edges(t, k, [a, b]);
-            if blocked.is_empty() {
-                let f = FACES[k].map(|j| tv[j]);
-                blocked = (0..3).map(|i| [f[i], f[(i + 1) % 3]]).collect();
-            }
-            if !blocked
-                .into_iter()
-                .any(|e| self.flipnm(e[0], e[1], level, budget, &mut Vec::new()))
-            {
+            if !self.clear_face(t, k, [a, b], level, budget) {
                 stuck_from[(a != a0) as usize] = true;
                 std::mem::swap(&mut a, &mut b);
                 continue;
@@ -782,6 +750,32 @@ impl Delaunay {
         }
     }
 
+    /// Take face k of tet t out of segment `seg`'s way: a 2-3 flip, else [`Delaunay::flipnm`]
+    /// on the reflex edges that block it (on each of its edges where none is reflex).
+    fn clear_face(
+        &mut self,
+        t: u32,
+        k: usize,
+        seg: [u32; 2],
+        level: u32,
+        budget: &mut usize,
+    ) -> bool {
+        if self.flip23(t, k) {
+            return true;
+        }
+        let mut blocked = self.blocking_edges(t, k, seg);
+        if blocked.is_empty() {
+            let f = FACES[k].map(|j| self.tets[t as usize][j]);
+            blocked = (0..3).map(|i| [f[i], f[(i + 1) % 3]]).collect();
+        }
+        blocked
+            .into_iter()
+            .any(|e| self.flipnm(e[0], e[1], level, budget, &mut Vec::new()))
+    }
+
+    /// Edge removal (n-to-2n-4 flip): replace the `around` tets sharing edge (x, y) by
+    /// tets on a fan triangulation of their ring of other vertices, joined to x and to y,
+    /// trying a fan from each ring vertex. False (nothing changed) if none is valid.
     pub(crate) fn remove_edge(&mut self, x: u32, y: u32, around: &[u32]) -> bool {
         let n = around.len();
         if !(3..=10).contains(&n) || self.fixed_edges.contains(&sorted2(x, y)) {
