@@ -119,6 +119,9 @@ pub struct FillTry {
     pub steiner_removal_seconds: f64,
     /// Steiner points edge and face recovery added (all on the surface until moved).
     pub steiner_points: usize,
+    /// Surface edges missing from the Delaunay tetrahedralization that the last try's
+    /// recursive flips brought in before any Steiner point (0 on the other tries).
+    pub flipped_segments: usize,
     /// Placing the interior points (the octree, the inside test and the clearance from
     /// the surface): on the first try, for the points inside, and again on the first
     /// try with the points outside too ([`FillTry::points_outside`]); 0 on the others.

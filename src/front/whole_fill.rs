@@ -152,6 +152,7 @@ fn whole_fill_trying(
                 faces_seconds: stages.faces,
                 steiner_removal_seconds: stages.steiner_removal,
                 steiner_points: stages.steiner_points,
+                flipped_segments: stages.flipped_segments,
                 points_seconds: std::mem::take(&mut placed),
                 finish_seconds: stages.finish,
             });
@@ -524,6 +525,9 @@ mod tests {
         let last = tries.last().unwrap();
         assert_eq!(last.steiner_at, "recursive flips, then halves");
         assert!(last.error.is_none(), "{last:?}");
+        // Of its 624 missing segments (TetGen's flips: all; greedy flips: 81; before
+        // the flips kept off the segment's way and were kept where it failed: 380).
+        assert!(last.flipped_segments >= 480, "{last:?}");
     }
 
     /// OpenSCAD part `name`'s whole fill with one way (`split`, `patience`), its interior

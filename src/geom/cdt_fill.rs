@@ -67,6 +67,9 @@ pub(crate) struct Stages {
     pub faces: f64,
     pub steiner_removal: f64,
     pub steiner_points: usize,
+    /// Segments missing from the Delaunay tetrahedralization that the recursive flip
+    /// pass brought in ([`Split::FlipsThenHalving`] only).
+    pub flipped_segments: usize,
     /// Contractions, lifts and the result, after the Steiner points moved.
     pub finish: f64,
     /// Steiner points that only the last round's larger cavities could move off the
@@ -129,6 +132,7 @@ pub(crate) fn fill_from(
     }
     let r = c.recover_edges();
     stages.edges = lap();
+    stages.flipped_segments = c.flipped_segments;
     stages.stuck_near = c.stuck_near;
     stages.steiner_points = c.dt.pts.len() - n - 4;
     r?;
@@ -174,13 +178,18 @@ const SLIVER_CONTRACT_DEG: f64 = 5.0;
 /// Rounds of [`Cdt::contract_flat`].
 const CONTRACT_ROUNDS: usize = 8;
 
-/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass (on drilled2, levels
-/// 0-4 leave 244 of 624 segments missing; levels 5-12 bring in 26 more at twice the
-/// time).
-const DEEP_FLIP_LEVELS: u32 = 4;
+/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass (TetGen goes on while
+/// its rounds make progress: up to level 22 on drilled2; here levels above 11 bring
+/// none in there).
+const DEEP_FLIP_LEVELS: u32 = 11;
 
-/// [`Delaunay::flipnm`] calls per segment and level in that pass.
-const DEEP_FLIP_BUDGET: usize = 20_000;
+/// [`Delaunay::flipnm`] calls per segment and level in that pass: a segment that comes
+/// in takes at most a few hundred (on drilled2), a failing search all it is given.
+const DEEP_FLIP_BUDGET: usize = 1_000;
+
+/// That pass stops raising the level once a level brings in fewer than 1 in this many
+/// of the segments still missing (each level costs about the same, whatever it brings).
+const DEEP_FLIP_STALL: usize = 20;
 
 /// Rounds of [`Cdt::lift_flat_tets`].
 const LIFT_ROUNDS: usize = 2;
@@ -190,13 +199,13 @@ const LIFT_ROUNDS: usize = 2;
 pub(crate) enum Split {
     /// [`Split::Halving`], after a pass of recursive flips ([`Delaunay::recover_edge_nm`])
     /// over every segment missing from the Delaunay tetrahedralization, the link level
-    /// raised from 0 to [`DEEP_FLIP_LEVELS`], the tetrahedralization restored where a
-    /// segment's flips fail. TetGen recovers CAD booleans' segments this way (on a
-    /// sphere drilled by two rotated holes, `scripts/csg-parts.py drilled2`, all 625
-    /// missing ones, with 13 Steiner points inside), where the greedy flips of the
-    /// other ways recover 81 and leave over a thousand Steiner points on the surface
-    /// among nearly coplanar chains; this pass brings 380 in, and halving then fills.
-    /// Slow (about 100 s there), so the whole fill's last try only.
+    /// raised from 0 while it brings segments in ([`Cdt::deep_flips`]). TetGen recovers
+    /// CAD booleans' segments this way (on a sphere drilled by two rotated holes,
+    /// `scripts/csg-parts.py drilled2`, all 625 missing ones, with 13 Steiner points
+    /// inside), where the greedy flips of the other ways recover 81 and leave over a
+    /// thousand Steiner points on the surface among nearly coplanar chains; this pass
+    /// brings about 500 in, and halving then fills. Slow (tens of seconds there), so
+    /// the whole fill's last try only.
     FlipsThenHalving,
     /// Where the piece leaves the tet at its current end: one point per crossed face at
     /// most, but a rounded point on a face (the other ways follow where that inverts a
@@ -314,6 +323,8 @@ struct Cdt<'a> {
     grow_limit: usize,
     /// Points that reached the round with [`GROW_LIMIT_LAST`].
     wide_cavity_points: usize,
+    /// [`Stages::flipped_segments`].
+    flipped_segments: usize,
     /// Whether [`Cdt::move_off`] leaves a point that only a tiny step would move off
     /// the surface on it, for a later round (every round of
     /// [`Cdt::remove_steiner_points`] but the last).
@@ -361,6 +372,7 @@ impl<'a> Cdt<'a> {
             grow: false,
             grow_limit: GROW_LIMIT,
             wide_cavity_points: 0,
+            flipped_segments: 0,
             defer_tiny: true,
             deferred: 0,
             stuck_near: None,
@@ -419,8 +431,10 @@ impl<'a> Cdt<'a> {
     }
 
     /// [`Split::FlipsThenHalving`]'s pass: each missing segment of `edges` by recursive
-    /// flips, level by level; one that comes in is fixed, one that does not leaves the
-    /// tetrahedralization as it was before its try.
+    /// flips, level by level; one that comes in is fixed. The flips of a segment that
+    /// does not come in are kept: none made a face or edge that segment crosses, and
+    /// the next level starts from where they left it (as TetGen's rounds do). The level
+    /// rises while a level brings in at least 1 in [`DEEP_FLIP_STALL`] of the missing.
     fn deep_flips(&mut self, edges: &[[u32; 2]]) {
         let mut missing: Vec<[u32; 2]> = edges
             .iter()
@@ -428,20 +442,18 @@ impl<'a> Cdt<'a> {
             .filter(|e| !self.chains.contains_key(e))
             .collect();
         for level in 0..=DEEP_FLIP_LEVELS {
-            let mut left = Vec::new();
-            for e in missing {
-                let before = self.dt.clone();
+            let before = missing.len();
+            missing.retain(|&e| {
                 let mut budget = DEEP_FLIP_BUDGET;
-                if self.dt.recover_edge_nm(e[0], e[1], level, &mut budget) {
-                    self.dt.fixed_edges.insert(e);
-                    self.chains.insert(e, e.to_vec());
-                } else {
-                    self.dt = before;
-                    left.push(e);
+                if !self.dt.recover_edge_nm(e[0], e[1], level, &mut budget) {
+                    return true;
                 }
-            }
-            missing = left;
-            if missing.is_empty() {
+                self.dt.fixed_edges.insert(e);
+                self.chains.insert(e, e.to_vec());
+                false
+            });
+            self.flipped_segments += before - missing.len();
+            if missing.is_empty() || (before - missing.len()) * DEEP_FLIP_STALL < before {
                 break;
             }
         }

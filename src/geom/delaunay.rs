@@ -84,6 +84,9 @@ pub(crate) struct Delaunay {
     /// below 1e-12 of the longest edge cubed): the constrained fill's recovery then
     /// makes none (`cdt_fill::Split::NoFlatTets`).
     pub refuse_flat: bool,
+    /// The segment [`Delaunay::recover_edge_nm`] is bringing in: no flip made meanwhile
+    /// may create a face or edge that it crosses ([`Delaunay::crosses_guard`]).
+    guard: Option<[u32; 2]>,
 }
 
 /// Per-tet marks, each walk's with a new stamp: clearing them is one increment.
@@ -181,6 +184,7 @@ impl Delaunay {
             magnitude: pts.iter().flatten().fold(0.0, |m, x| m.max(x.abs())),
             walked: RefCell::default(),
             refuse_flat: false,
+            guard: None,
         };
         for i in 0..n as u32 {
             dt.insert(i);
@@ -517,6 +521,9 @@ impl Delaunay {
         if !new.iter().all(|&n| self.valid_new(n)) {
             return false;
         }
+        if f.iter().any(|&c| self.crosses_guard([a, b, c], &[[a, b]])) {
+            return false;
+        }
         self.replace(&[t, u], &new);
         true
     }
@@ -547,7 +554,7 @@ impl Delaunay {
         if !self.positive(t2) {
             t2.swap(0, 1);
         }
-        if !self.valid_new(t1) || !self.valid_new(t2) {
+        if !self.valid_new(t1) || !self.valid_new(t2) || self.crosses_guard([p, q, r], &[]) {
             return false;
         }
         // a and b on opposite sides of (p, q, r) (else the two tets overlap).
@@ -630,6 +637,38 @@ impl Delaunay {
             .collect()
     }
 
+    /// Whether the guarded segment ([`Delaunay::guard`]) crosses face `f` through its
+    /// interior, or one of its edges listed in `new` through the edge's interior: a face
+    /// and edges a flip would create. A segment in the face's plane is not judged.
+    fn crosses_guard(&self, f: [u32; 3], new: &[[u32; 2]]) -> bool {
+        let Some([s, t]) = self.guard else {
+            return false;
+        };
+        let [p, q, r] = f.map(|v| self.p(v));
+        let (ps, pt) = (self.p(s), self.p(t));
+        if orient3d(p, q, r, ps) == orient3d(p, q, r, pt) {
+            return false; // one side, or in the plane
+        }
+        // The segment meets the plane at one point: where, relative to the edges.
+        let o = [
+            orient3d(ps, pt, p, q),
+            orient3d(ps, pt, q, r),
+            orient3d(ps, pt, r, p),
+        ];
+        if o.contains(&1) && o.contains(&-1) {
+            return false;
+        }
+        match o.iter().filter(|&&x| x == 0).count() {
+            0 => true,
+            1 => {
+                let k = o.iter().position(|&x| x == 0).unwrap_or(0);
+                let e = sorted2(f[k], f[(k + 1) % 3]);
+                new.iter().any(|n| sorted2(n[0], n[1]) == e)
+            }
+            _ => false, // through a vertex
+        }
+    }
+
     /// Remove edge (x, y) by a sequence of flips (after Si's flipnm): 3-2 when three tets
     /// share it; else shrink its star by 2-3 flips of its faces; where those are blocked
     /// by reflex link edges, remove those first, `level` levels deep. `anc` holds the
@@ -703,7 +742,12 @@ impl Delaunay {
     /// face it crosses first from a is 2-3 flipped, or the reflex edge that blocks that
     /// flip removed; stuck there, the same from b; stuck at both ends, any face it
     /// crosses further in. `budget` bounds the [`Delaunay::flipnm`] calls. True when the
-    /// edge is there (the flips made on the way are kept either way).
+    /// edge is there (the flips made on the way are kept either way). Meanwhile no flip
+    /// but that of a crossed face itself makes a face or edge the segment crosses
+    /// ([`Delaunay::crosses_guard`], TetGen's flip eligibility check): each flip from an
+    /// end takes a crossing away and none adds one, so the flips cannot undo each other
+    /// (without that check, most of the search went round in circles until its budget was
+    /// spent).
     pub(crate) fn recover_edge_nm(
         &mut self,
         a0: u32,
@@ -711,6 +755,13 @@ impl Delaunay {
         level: u32,
         budget: &mut usize,
     ) -> bool {
+        self.guard = Some([a0, b0]);
+        let r = self.recover_edge_guarded(a0, b0, level, budget);
+        self.guard = None;
+        r
+    }
+
+    fn recover_edge_guarded(&mut self, a0: u32, b0: u32, level: u32, budget: &mut usize) -> bool {
         let mut stuck_from = [false; 2];
         let (mut a, mut b) = (a0, b0);
         loop {
@@ -760,7 +811,12 @@ impl Delaunay {
         level: u32,
         budget: &mut usize,
     ) -> bool {
-        if self.flip23(t, k) {
+        // The crossed face itself may go whatever its new faces meet (as TetGen's
+        // removefacebyflips).
+        let guard = self.guard.take();
+        let flipped = self.flip23(t, k);
+        self.guard = guard;
+        if flipped {
             return true;
         }
         let mut blocked = self.blocking_edges(t, k, seg);
@@ -807,6 +863,23 @@ impl Delaunay {
                     }
                     new.push(t);
                 }
+            }
+            let a = ring[apex];
+            let guarded = (1..n - 1).any(|k| {
+                let (b, c) = (ring[(apex + k) % n], ring[(apex + k + 1) % n]);
+                // The fan's diagonals from a are new edges; the ring's edges are not.
+                let diag: Vec<[u32; 2]> = [(k > 1, [a, b]), (k < n - 2, [a, c])]
+                    .into_iter()
+                    .filter_map(|(d, e)| d.then_some(e))
+                    .collect();
+                self.crosses_guard([a, b, c], &diag)
+                    || (k > 1
+                        && [x, y]
+                            .iter()
+                            .any(|&z| self.crosses_guard([a, b, z], &[[a, b]])))
+            });
+            if guarded {
+                continue 'fans;
             }
             // Positive tets with the old tets' boundary tile their region exactly (a fan
             // triangle turned against the others would make an overlap; a volume
