@@ -410,8 +410,9 @@ fn high_order_params(opts: &Options) -> HighOrderParams {
     }
 }
 
-/// A front failure on a surface with poorly shaped or mostly elongated triangles says so,
-/// and what helps.
+/// A meshing failure says that it is a bug (the surface passed every check, and the
+/// whole fill is meant to mesh any such surface), and, on a surface with poorly shaped
+/// or mostly elongated triangles, so and what may get round it meanwhile.
 fn with_shape_hint(e: Error, s: &Surface) -> Error {
     use crate::surface::geometry::{
         triangle_shape, ELONGATED_MEDIAN_ASPECT_RATIO, POOR_ASPECT_RATIO,
@@ -427,7 +428,8 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
              {POOR_ASPECT_RATIO}, worst {worst:.0}); the front needs well-shaped boundary \
              triangles: smooth a surface from image segmentation before curving (CLI \
              `--smooth 10`, `CurveOptions::smooth_iterations`, C \
-             `curvetet_surface_from_linear_smoothed`) or remesh it",
+             `curvetet_surface_from_linear_smoothed`); remesh a CAD part's needle and cap \
+             triangles (smoothing moves its sharp edges)",
             s.triangles().len(),
         )
     } else if shape.elongated() {
@@ -438,13 +440,24 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
              isotropic triangles"
         )
     } else {
-        return Error::MeshingFailed { msg, partial };
+        String::new()
+    };
+    let note = if note.is_empty() {
+        String::new()
+    } else {
+        format!(" Meanwhile: {note}.")
     };
     Error::MeshingFailed {
-        msg: format!("{msg}. Note: {note}"),
+        msg: format!("{msg}. {REPORT_FAILURE}{note}"),
         partial,
     }
 }
+
+/// What every meshing failure says: the surface passed the checks, so the failure is
+/// curvetet's.
+const REPORT_FAILURE: &str = "This surface passed the surface checks, so curvetet should \
+                              mesh it: this is a bug, please report it with the surface \
+                              file.";
 
 /// The environment variable that makes [`generate`] corrupt its own mesh just before the
 /// final check, to prove the check catches it (`Error::InvalidMesh`, C status
@@ -666,15 +679,18 @@ mod tests {
             panic!("not a meshing failure");
         };
         assert!(
-            msg.starts_with("stuck. Note: 101 of 2316 boundary triangles"),
+            msg.starts_with(&format!(
+                "stuck. {REPORT_FAILURE} Meanwhile: 101 of 2316 boundary triangles"
+            )),
             "{msg}"
         );
         assert!(msg.contains("--smooth 10"), "{msg}");
-        // Well-shaped triangles: the message is left alone; other errors too.
+        // Well-shaped triangles: only the request for a report; other errors are left
+        // alone.
         let Error::MeshingFailed { msg, .. } = with_shape_hint(failed(), &mc_blob(10)) else {
             panic!("not a meshing failure");
         };
-        assert_eq!(msg, "stuck");
+        assert_eq!(msg, format!("stuck. {REPORT_FAILURE}"));
         let e = with_shape_hint(Error::Cancelled, &mc_blob(0));
         assert!(matches!(e, Error::Cancelled));
     }
@@ -696,9 +712,10 @@ mod tests {
             panic!("not a meshing failure");
         };
         assert!(
-            msg.starts_with(
-                "stuck. Note: most boundary triangles are elongated (median aspect ratio 3."
-            ),
+            msg.starts_with(&format!(
+                "stuck. {REPORT_FAILURE} Meanwhile: most boundary triangles are elongated \
+                 (median aspect ratio 3."
+            )),
             "{msg}"
         );
         assert!(msg.contains("remesh the surface"), "{msg}");
@@ -706,7 +723,7 @@ mod tests {
         let Error::MeshingFailed { msg, .. } = with_shape_hint(failed(), &surface(50, 54)) else {
             panic!("not a meshing failure");
         };
-        assert_eq!(msg, "stuck");
+        assert_eq!(msg, format!("stuck. {REPORT_FAILURE}"));
     }
 
     /// The corner qualities the front hands to the linear stage are, bit for bit, what
