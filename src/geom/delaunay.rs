@@ -761,6 +761,7 @@ impl Delaunay {
         r
     }
 
+    /// [`Delaunay::recover_edge_nm`] with the guard set.
     fn recover_edge_guarded(&mut self, a0: u32, b0: u32, level: u32, budget: &mut usize) -> bool {
         let mut stuck_from = [false; 2];
         let (mut a, mut b) = (a0, b0);
@@ -1511,6 +1512,44 @@ mod tests {
         assert_eq!(insphere(a, b, c, d, [0.2, 0.2, 0.2]), 1);
         assert_eq!(insphere(a, b, c, d, [5.0, 5.0, 5.0]), -1);
         assert_eq!(insphere(a, b, c, d, [1.0, 1.0, 0.0]), 0);
+    }
+
+    /// The segment from (0, 0, -1) to (0, 0, 1) against faces in the plane z = 0: through
+    /// the interior it crosses; through an edge's interior only if that edge is new;
+    /// through a vertex, beside the face or in its plane, not.
+    #[test]
+    fn a_guarded_segment_crosses_new_faces_and_edges_only() {
+        let pts = [
+            [0.0, 0.0, -1.0], // 0, 1: the segment
+            [0.0, 0.0, 1.0],
+            [-1.0, -1.0, 0.0], // 2, 3, 4: around the origin
+            [1.0, -1.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [-1.0, 0.0, 0.0], // 5, 6: an edge through the origin
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0],  // 7: the origin
+            [3.0, 3.0, 0.0],  // 8
+            [0.0, 0.0, -0.5], // 9: on the segment, below the plane
+        ];
+        let mut dt = Delaunay::new(&pts);
+        assert!(!dt.crosses_guard([2, 3, 4], &[]), "no guard, no crossing");
+        dt.guard = Some([0, 1]);
+        assert!(dt.crosses_guard([2, 3, 4], &[]));
+        assert!(dt.crosses_guard([5, 6, 4], &[[6, 5]]));
+        assert!(!dt.crosses_guard([5, 6, 4], &[[6, 4], [4, 5]]));
+        assert!(!dt.crosses_guard([7, 3, 4], &[[7, 3], [3, 4], [4, 7]]));
+        assert!(!dt.crosses_guard([3, 4, 8], &[[3, 4], [4, 8], [8, 3]]));
+        assert!(!dt.crosses_guard([0, 9, 3], &[[0, 9], [9, 3], [3, 0]]));
+        dt.guard = Some([0, 9]);
+        assert!(
+            !dt.crosses_guard([2, 3, 4], &[]),
+            "the segment ends before the plane"
+        );
+        dt.guard = Some([0, 7]);
+        assert!(
+            !dt.crosses_guard([7, 3, 4], &[[7, 3]]),
+            "ends at the face's vertex"
+        );
     }
 
     #[test]
