@@ -205,7 +205,7 @@ pub(crate) enum Split {
     /// `scripts/csg-parts.py drilled2`, all 625 missing ones, with 13 Steiner points
     /// inside), where the greedy flips of the other ways recover 81 and leave over a
     /// thousand Steiner points on the surface among nearly coplanar chains; this pass
-    /// brings about 540 in, and halving then fills. Slow (tens of seconds there), so
+    /// brings about 500 in, and halving then fills. Slow (tens of seconds there), so
     /// the whole fill's last try only.
     FlipsThenHalving,
     /// Where the piece leaves the tet at its current end: one point per crossed face at
