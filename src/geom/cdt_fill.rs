@@ -178,19 +178,18 @@ const SLIVER_CONTRACT_DEG: f64 = 5.0;
 /// Rounds of [`Cdt::contract_flat`].
 const CONTRACT_ROUNDS: usize = 8;
 
-/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass (TetGen's rounds go to
-/// level 22 on drilled2 and 40 on a three-hole sphere, through rounds that bring
-/// nothing in).
-const DEEP_FLIP_LEVELS: u32 = 40;
+/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass (TetGen goes on while
+/// its rounds make progress: up to level 22 on drilled2; here levels above 11 bring
+/// none in there).
+const DEEP_FLIP_LEVELS: u32 = 11;
 
 /// [`Delaunay::flipnm`] calls per segment and level in that pass: a segment that comes
 /// in takes at most a few hundred (on drilled2), a failing search all it is given.
 const DEEP_FLIP_BUDGET: usize = 1_000;
 
-/// That pass stops raising the level after this many levels in a row that bring no
-/// segment in (each level costs about the same, whatever it brings: on drilled2 about
-/// 0.3 s once a hundred segments are left).
-const DEEP_FLIP_STALL: u32 = 5;
+/// That pass stops raising the level once a level brings in fewer than 1 in this many
+/// of the segments still missing (each level costs about the same, whatever it brings).
+const DEEP_FLIP_STALL: usize = 20;
 
 /// Rounds of [`Cdt::lift_flat_tets`].
 const LIFT_ROUNDS: usize = 2;
@@ -435,14 +434,13 @@ impl<'a> Cdt<'a> {
     /// flips, level by level; one that comes in is fixed. The flips of a segment that
     /// does not come in are kept: none made a face or edge that segment crosses, and
     /// the next level starts from where they left it (as TetGen's rounds do). The level
-    /// rises until [`DEEP_FLIP_STALL`] levels in a row bring none in.
+    /// rises while a level brings in at least 1 in [`DEEP_FLIP_STALL`] of the missing.
     fn deep_flips(&mut self, edges: &[[u32; 2]]) {
         let mut missing: Vec<[u32; 2]> = edges
             .iter()
             .copied()
             .filter(|e| !self.chains.contains_key(e))
             .collect();
-        let mut idle = 0;
         for level in 0..=DEEP_FLIP_LEVELS {
             let before = missing.len();
             missing.retain(|&e| {
@@ -455,8 +453,7 @@ impl<'a> Cdt<'a> {
                 false
             });
             self.flipped_segments += before - missing.len();
-            idle = if missing.len() < before { 0 } else { idle + 1 };
-            if missing.is_empty() || idle == DEEP_FLIP_STALL {
+            if missing.is_empty() || (before - missing.len()) * DEEP_FLIP_STALL < before {
                 break;
             }
         }
