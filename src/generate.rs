@@ -422,8 +422,8 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
     };
     let shape = triangle_shape(s.nodes(), s.triangles());
     let (poor, worst, median) = (shape.poor, shape.worst, shape.median);
-    let note = if poor > 0 {
-        format!(
+    let hint = if poor > 0 {
+        Some(format!(
             "{poor} of {} boundary triangles are poorly shaped (aspect ratio above \
              {POOR_ASPECT_RATIO}, worst {worst:.0}); the front needs well-shaped boundary \
              triangles: smooth a surface from image segmentation before curving (CLI \
@@ -431,24 +431,22 @@ fn with_shape_hint(e: Error, s: &Surface) -> Error {
              `curvetet_surface_from_linear_smoothed`); remesh a CAD part's needle and cap \
              triangles (smoothing moves its sharp edges)",
             s.triangles().len(),
-        )
+        ))
     } else if shape.elongated() {
-        format!(
+        Some(format!(
             "most boundary triangles are elongated (median aspect ratio {median:.1}, above \
              {ELONGATED_MEDIAN_ASPECT_RATIO}; worst {worst:.1}), and the front gets stuck \
              where long boundary edges meet short ones: remesh the surface with more \
              isotropic triangles"
-        )
+        ))
     } else {
-        String::new()
+        None
     };
-    let note = if note.is_empty() {
-        String::new()
-    } else {
-        format!(" Meanwhile: {note}.")
-    };
+    let meanwhile = hint
+        .map(|h| format!(" Meanwhile: {h}."))
+        .unwrap_or_default();
     Error::MeshingFailed {
-        msg: format!("{msg}. {REPORT_FAILURE}{note}"),
+        msg: format!("{msg}. {REPORT_FAILURE}{meanwhile}"),
         partial,
     }
 }

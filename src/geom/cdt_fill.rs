@@ -178,9 +178,10 @@ const SLIVER_CONTRACT_DEG: f64 = 5.0;
 /// Rounds of [`Cdt::contract_flat`].
 const CONTRACT_ROUNDS: usize = 8;
 
-/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass (TetGen goes on while
-/// its rounds make progress: up to level 22 on drilled2; here levels above 11 bring
-/// none in there).
+/// Highest link level of [`Split::FlipsThenHalving`]'s flip pass. TetGen's rounds go to
+/// level 22 on drilled2; here the stall rule ([`DEEP_FLIP_STALL`]) ends the pass at
+/// level 8 there. Going on to level 40 brought 39 more of drilled2's segments in, but
+/// left an unseen four-hole sphere (offset holes) that meshes this way unmeshed.
 const DEEP_FLIP_LEVELS: u32 = 11;
 
 /// [`Delaunay::flipnm`] calls per segment and level in that pass: a segment that comes

@@ -669,6 +669,30 @@ impl Delaunay {
         }
     }
 
+    /// Whether the fan from `ring[apex]` that [`Delaunay::remove_edge`] would make for edge
+    /// (x, y) has a face the guarded segment crosses ([`Delaunay::crosses_guard`]): a
+    /// fan triangle, or a diagonal's triangle with x or y; the diagonals from the apex
+    /// are new edges, the ring's edges are not.
+    fn fan_crosses_guard(&self, ring: &[u32], apex: usize, x: u32, y: u32) -> bool {
+        let n = ring.len();
+        let a = ring[apex];
+        (1..n - 1).any(|k| {
+            let (b, c) = (ring[(apex + k) % n], ring[(apex + k + 1) % n]);
+            let (ab_new, ac_new) = (k > 1, k < n - 2);
+            let diag = match (ab_new, ac_new) {
+                (true, true) => &[[a, b], [a, c]][..],
+                (true, false) => &[[a, b]][..],
+                (false, true) => &[[a, c]][..],
+                (false, false) => &[][..],
+            };
+            self.crosses_guard([a, b, c], diag)
+                || (ab_new
+                    && [x, y]
+                        .iter()
+                        .any(|&z| self.crosses_guard([a, b, z], &[[a, b]])))
+        })
+    }
+
     /// Remove edge (x, y) by a sequence of flips (after Si's flipnm): 3-2 when three tets
     /// share it; else shrink its star by 2-3 flips of its faces; where those are blocked
     /// by reflex link edges, remove those first, `level` levels deep. `anc` holds the
@@ -865,21 +889,7 @@ impl Delaunay {
                     new.push(t);
                 }
             }
-            let a = ring[apex];
-            let guarded = (1..n - 1).any(|k| {
-                let (b, c) = (ring[(apex + k) % n], ring[(apex + k + 1) % n]);
-                // The fan's diagonals from a are new edges; the ring's edges are not.
-                let diag: Vec<[u32; 2]> = [(k > 1, [a, b]), (k < n - 2, [a, c])]
-                    .into_iter()
-                    .filter_map(|(d, e)| d.then_some(e))
-                    .collect();
-                self.crosses_guard([a, b, c], &diag)
-                    || (k > 1
-                        && [x, y]
-                            .iter()
-                            .any(|&z| self.crosses_guard([a, b, z], &[[a, b]])))
-            });
-            if guarded {
+            if self.guard.is_some() && self.fan_crosses_guard(&ring, apex, x, y) {
                 continue 'fans;
             }
             // Positive tets with the old tets' boundary tile their region exactly (a fan
